@@ -1,0 +1,14 @@
+//! interact3d: turn composed 3D scenes into simulation-ready assets and prove they are
+//! physically sound.
+//!
+//! The modules follow the data through the pipeline:
+//! [`mesh`] (the model) → [`io`] (file formats) → [`scene`] (sample folders and manifests) →
+//! [`prepare`] (metres, Z-up, on the ground) → [`decompose`] (convex hulls) → [`inertia`] →
+//! [`export`] (MJCF, URDF) → [`metrics`] and [`physics`] (validation).
+
+pub mod error;
+pub mod mesh;
+pub mod pose;
+pub mod shapes;
+
+pub use error::{Error, Result};

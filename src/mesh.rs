@@ -1,0 +1,308 @@
+//! The mesh model every stage shares.
+//!
+//! * [`Mesh`]: welded triangle geometry in `f64` (positions + triangles). All geometry
+//!   (decomposition, inertia, metrics, physics) works on it.
+//! * [`VisualMesh`]: what is rendered: parts with UVs and a material each, kept apart so textures
+//!   survive the round trip to OBJ/MTL.
+
+use nalgebra::{Matrix4, Point3, Vector3};
+use std::collections::HashMap;
+use std::sync::Arc;
+
+/// A point in 3D, `f64`.
+pub type P3 = Point3<f64>;
+/// A vector in 3D, `f64`.
+pub type V3 = Vector3<f64>;
+
+/// Axis-aligned bounding box.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Aabb {
+    pub min: P3,
+    pub max: P3,
+}
+
+impl Aabb {
+    /// The box of a set of points; `None` when there are none.
+    pub fn of_points<'a>(points: impl IntoIterator<Item = &'a P3>) -> Option<Aabb> {
+        let mut it = points.into_iter();
+        let first = *it.next()?;
+        let mut b = Aabb {
+            min: first,
+            max: first,
+        };
+        for p in it {
+            b.include(p);
+        }
+        Some(b)
+    }
+    /// Grow to contain `p`.
+    pub fn include(&mut self, p: &P3) {
+        self.min = self.min.inf(p);
+        self.max = self.max.sup(p);
+    }
+    /// Smallest box containing both.
+    pub fn union(&self, o: &Aabb) -> Aabb {
+        Aabb {
+            min: self.min.inf(&o.min),
+            max: self.max.sup(&o.max),
+        }
+    }
+    /// Extents along x, y, z.
+    pub fn extents(&self) -> V3 {
+        self.max - self.min
+    }
+    /// Length of the diagonal.
+    pub fn diagonal(&self) -> f64 {
+        self.extents().norm()
+    }
+    /// Centre of the box.
+    pub fn center(&self) -> P3 {
+        nalgebra::center(&self.min, &self.max)
+    }
+    /// Whether the two boxes overlap (touching counts), after growing `self` by `margin`.
+    pub fn intersects(&self, o: &Aabb, margin: f64) -> bool {
+        (0..3).all(|i| self.min[i] - margin <= o.max[i] && o.min[i] <= self.max[i] + margin)
+    }
+}
+
+/// Welded triangle geometry. Triangles are counter-clockwise seen from outside for closed meshes.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Mesh {
+    pub vertices: Vec<P3>,
+    pub triangles: Vec<[u32; 3]>,
+}
+
+impl Mesh {
+    pub fn new(vertices: Vec<P3>, triangles: Vec<[u32; 3]>) -> Self {
+        Mesh {
+            vertices,
+            triangles,
+        }
+    }
+
+    /// Bounding box; `None` for an empty mesh.
+    pub fn aabb(&self) -> Option<Aabb> {
+        Aabb::of_points(&self.vertices)
+    }
+
+    /// The three corners of triangle `i`.
+    pub fn triangle(&self, i: usize) -> [P3; 3] {
+        let t = self.triangles[i];
+        [
+            self.vertices[t[0] as usize],
+            self.vertices[t[1] as usize],
+            self.vertices[t[2] as usize],
+        ]
+    }
+
+    /// Total surface area.
+    pub fn area(&self) -> f64 {
+        (0..self.triangles.len())
+            .map(|i| triangle_area(&self.triangle(i)))
+            .sum()
+    }
+
+    /// Signed enclosed volume (divergence theorem); positive for outward-facing closed meshes.
+    pub fn signed_volume(&self) -> f64 {
+        (0..self.triangles.len())
+            .map(|i| {
+                let [a, b, c] = self.triangle(i);
+                a.coords.dot(&b.coords.cross(&c.coords)) / 6.0
+            })
+            .sum()
+    }
+
+    /// Closed (watertight and consistently oriented): every directed edge appears once and its
+    /// reverse appears once.
+    pub fn is_closed(&self) -> bool {
+        if self.triangles.is_empty() {
+            return false;
+        }
+        let mut edges: HashMap<(u32, u32), i32> = HashMap::with_capacity(self.triangles.len() * 3);
+        for t in &self.triangles {
+            for k in 0..3 {
+                *edges.entry((t[k], t[(k + 1) % 3])).or_insert(0) += 1;
+            }
+        }
+        edges
+            .iter()
+            .all(|(&(a, b), &n)| n == 1 && edges.get(&(b, a)) == Some(&1))
+    }
+
+    /// Apply a 4x4 affine transform to every vertex. A transform with negative determinant
+    /// flips the triangle winding back so outward normals stay outward.
+    pub fn transformed(&self, m: &Matrix4<f64>) -> Mesh {
+        let vertices = self.vertices.iter().map(|p| m.transform_point(p)).collect();
+        let flip = m.fixed_view::<3, 3>(0, 0).determinant() < 0.0;
+        let triangles = if flip {
+            self.triangles.iter().map(|t| [t[0], t[2], t[1]]).collect()
+        } else {
+            self.triangles.clone()
+        };
+        Mesh {
+            vertices,
+            triangles,
+        }
+    }
+
+    /// Append another mesh (indices shifted).
+    pub fn append(&mut self, other: &Mesh) {
+        let off = self.vertices.len() as u32;
+        self.vertices.extend_from_slice(&other.vertices);
+        self.triangles.extend(
+            other
+                .triangles
+                .iter()
+                .map(|t| [t[0] + off, t[1] + off, t[2] + off]),
+        );
+    }
+
+    /// Merge vertices whose positions are equal to within `tolerance` (a grid of that size;
+    /// 0 merges only bit-identical positions) and drop triangles that become degenerate.
+    /// Deterministic: the first occurrence of a position keeps its place.
+    pub fn welded(&self, tolerance: f64) -> Mesh {
+        let key = |p: &P3| -> [i64; 3] {
+            if tolerance > 0.0 {
+                [
+                    (p.x / tolerance).round() as i64,
+                    (p.y / tolerance).round() as i64,
+                    (p.z / tolerance).round() as i64,
+                ]
+            } else {
+                [
+                    p.x.to_bits() as i64,
+                    p.y.to_bits() as i64,
+                    p.z.to_bits() as i64,
+                ]
+            }
+        };
+        let mut map: HashMap<[i64; 3], u32> = HashMap::with_capacity(self.vertices.len());
+        let mut vertices = Vec::new();
+        let remap: Vec<u32> = self
+            .vertices
+            .iter()
+            .map(|p| {
+                *map.entry(key(p)).or_insert_with(|| {
+                    vertices.push(*p);
+                    (vertices.len() - 1) as u32
+                })
+            })
+            .collect();
+        let triangles = self
+            .triangles
+            .iter()
+            .map(|t| {
+                [
+                    remap[t[0] as usize],
+                    remap[t[1] as usize],
+                    remap[t[2] as usize],
+                ]
+            })
+            .filter(|t| t[0] != t[1] && t[1] != t[2] && t[0] != t[2])
+            .collect();
+        Mesh {
+            vertices,
+            triangles,
+        }
+    }
+
+    /// Vertices and triangles in parry's types (`glam::DVec3`).
+    pub fn to_parry(&self) -> (Vec<parry3d_f64::math::Vector>, Vec<[u32; 3]>) {
+        (
+            self.vertices.iter().map(|p| to_dvec(p)).collect(),
+            self.triangles.clone(),
+        )
+    }
+}
+
+/// Area of a triangle.
+pub fn triangle_area(t: &[P3; 3]) -> f64 {
+    0.5 * (t[1] - t[0]).cross(&(t[2] - t[0])).norm()
+}
+
+/// nalgebra point to parry's vector type.
+pub fn to_dvec(p: &P3) -> parry3d_f64::math::Vector {
+    parry3d_f64::math::Vector::new(p.x, p.y, p.z)
+}
+
+/// parry's vector type to a nalgebra point.
+pub fn from_dvec(v: parry3d_f64::math::Vector) -> P3 {
+    P3::new(v.x, v.y, v.z)
+}
+
+/// Encoded image data of a texture, kept as read (PNG or JPEG), decoded only when written.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Texture {
+    /// Where it came from (a file path, or `file.glb#image3`), for error messages.
+    pub origin: String,
+    /// The encoded bytes.
+    pub bytes: Arc<Vec<u8>>,
+    /// Pixel size, read from the header at load time.
+    pub width: u32,
+    pub height: u32,
+}
+
+/// A material: base colour factor (linear RGBA) and an optional base-colour texture.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Material {
+    pub name: String,
+    pub base_color: [f64; 4],
+    pub texture: Option<Texture>,
+}
+
+impl Default for Material {
+    fn default() -> Self {
+        Material {
+            name: "default".into(),
+            base_color: [0.8, 0.8, 0.8, 1.0],
+            texture: None,
+        }
+    }
+}
+
+/// One part of a visual mesh: a triangle list with its own vertices, optional UVs and a material.
+#[derive(Clone, Debug, PartialEq)]
+pub struct VisualPart {
+    pub positions: Vec<P3>,
+    /// One UV per position when present (glTF convention: v grows downwards).
+    pub uvs: Option<Vec<[f64; 2]>>,
+    pub triangles: Vec<[u32; 3]>,
+    pub material: Material,
+}
+
+/// A renderable mesh: one or more parts with materials.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct VisualMesh {
+    pub parts: Vec<VisualPart>,
+}
+
+impl VisualMesh {
+    /// The geometry of all parts together, vertices welded exactly (UV seams joined).
+    pub fn geometry(&self) -> Mesh {
+        let mut m = Mesh::default();
+        for p in &self.parts {
+            m.append(&Mesh::new(p.positions.clone(), p.triangles.clone()));
+        }
+        m.welded(0.0)
+    }
+
+    /// Number of triangles over all parts.
+    pub fn triangle_count(&self) -> usize {
+        self.parts.iter().map(|p| p.triangles.len()).sum()
+    }
+
+    /// Apply an affine transform to every position (winding flipped for mirroring transforms).
+    pub fn transform(&mut self, m: &Matrix4<f64>) {
+        let flip = m.fixed_view::<3, 3>(0, 0).determinant() < 0.0;
+        for p in &mut self.parts {
+            for v in &mut p.positions {
+                *v = m.transform_point(v);
+            }
+            if flip {
+                for t in &mut p.triangles {
+                    t.swap(1, 2);
+                }
+            }
+        }
+    }
+}
