@@ -6,9 +6,19 @@
 //! [`prepare`] (metres, Z-up, on the ground) → [`decompose`] (convex hulls) → [`inertia`] →
 //! [`export`] (MJCF, URDF) → [`metrics`] and [`physics`] (validation).
 
+pub mod body;
+pub mod decompose;
 pub mod error;
+pub mod export;
+pub mod fsutil;
+pub mod inertia;
+pub mod io;
 pub mod mesh;
+pub mod pipeline;
 pub mod pose;
+pub mod prepare;
+pub mod report;
+pub mod scene;
 pub mod shapes;
 
 pub use error::{Error, Result};

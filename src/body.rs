@@ -1,0 +1,191 @@
+//! Bodies: what a simulator gets for each object. The frame of a body is at its centre of mass
+//! with world-aligned axes at the composed pose; visual and collision geometry are expressed in it.
+
+use crate::decompose::{vhacd::Vhacd, DecomposeOptions, Decomposer, Hull};
+use crate::error::{Error, Result};
+use crate::inertia::{self, Inertial, VolumeSource, DEFAULT_DENSITY};
+use crate::mesh::{Mesh, VisualMesh, V3};
+use crate::pose::Similarity;
+use crate::prepare::{prepare, PrepareOptions, PreparedScene};
+use crate::scene::Scene;
+use nalgebra::{Isometry3, Translation3, UnitQuaternion};
+
+/// Default friction coefficient when the scene gives none.
+pub const DEFAULT_FRICTION: f64 = 0.8;
+
+/// One rigid body.
+#[derive(Clone, Debug)]
+pub struct Body {
+    pub name: String,
+    pub label: Option<String>,
+    /// World pose of the body frame to start the simulation from (composed, or settled).
+    pub pose: Isometry3<f64>,
+    /// World pose of the body frame as composed.
+    pub composed_pose: Isometry3<f64>,
+    /// Original mesh frame → body frame.
+    pub mesh_to_body: Similarity,
+    /// Visual mesh in the body frame.
+    pub visual: VisualMesh,
+    /// Welded geometry in the body frame.
+    pub geometry: Mesh,
+    /// Convex collision hulls in the body frame.
+    pub hulls: Vec<Hull>,
+    /// Mass properties in the body frame (centre of mass at the origin).
+    pub inertial: Inertial,
+    pub friction: f64,
+    pub fixed: bool,
+    pub closed: bool,
+    pub warnings: Vec<String>,
+}
+
+impl Body {
+    /// Geometry at the composed pose, world frame.
+    pub fn world_geometry(&self) -> Mesh {
+        self.geometry
+            .transformed(&self.composed_pose.to_homogeneous())
+    }
+    /// Hulls at the composed pose, world frame.
+    pub fn world_hulls(&self) -> Vec<Hull> {
+        self.hulls
+            .iter()
+            .map(|h| h.transformed(&self.composed_pose))
+            .collect()
+    }
+}
+
+/// A scene of bodies ready to export or simulate.
+#[derive(Clone, Debug)]
+pub struct Assembly {
+    pub name: String,
+    pub bodies: Vec<Body>,
+    /// Decomposition engine used.
+    pub decomposer: String,
+    /// Scene-unit → world similarity applied by preparation.
+    pub scene_to_world: Similarity,
+    pub warnings: Vec<String>,
+}
+
+/// Which decomposition engine to use.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, clap::ValueEnum)]
+pub enum Engine {
+    /// parry's V-HACD, each object alone.
+    #[default]
+    Vhacd,
+}
+
+impl Engine {
+    pub fn decomposer(&self) -> Box<dyn Decomposer> {
+        match self {
+            Engine::Vhacd => Box::new(Vhacd),
+        }
+    }
+}
+
+/// Options of the whole build (prepare → decompose → inertia).
+#[derive(Clone, Debug, Default)]
+pub struct BuildOptions {
+    pub prepare: PrepareOptions,
+    pub decompose: DecomposeOptions,
+    pub engine: Engine,
+}
+
+/// Load-to-bodies in one call.
+pub fn build(scene: &Scene, opts: &BuildOptions) -> Result<Assembly> {
+    let prepared = prepare(scene, &opts.prepare)?;
+    assemble(
+        &prepared,
+        &*opts.engine.decomposer(),
+        &opts.decompose,
+        &scene.source,
+    )
+}
+
+/// Decompose a prepared scene and compute its bodies.
+pub fn assemble(
+    prepared: &PreparedScene,
+    engine: &dyn Decomposer,
+    dopts: &DecomposeOptions,
+    source: &std::path::Path,
+) -> Result<Assembly> {
+    let meshes: Vec<&Mesh> = prepared.objects.iter().map(|o| &o.geometry).collect();
+    let hull_sets = engine.decompose(&meshes, dopts)?;
+    let mut bodies = Vec::with_capacity(prepared.objects.len());
+    for (o, hulls) in prepared.objects.iter().zip(hull_sets) {
+        let density = o.physical.density.unwrap_or(DEFAULT_DENSITY);
+        let mut warnings = o.warnings.clone();
+        if hulls.is_empty() {
+            return Err(Error::input(
+                source,
+                format!(
+                    "object {}: no usable convex hull (the mesh is flat or degenerate)",
+                    o.name
+                ),
+            ));
+        }
+        let mut inertial = None;
+        if o.closed {
+            let m = inertia::of_closed_mesh(&o.geometry, density);
+            if m.check().is_ok() && m.volume > 0.0 {
+                inertial = Some(m);
+            } else {
+                warnings.push("closed mesh gave invalid mass properties (inward-facing or self-intersecting?): using the hull union".into());
+            }
+        }
+        let mut inertial = match inertial {
+            Some(m) => m,
+            None => inertia::of_hull_union(&hulls, density, 96).ok_or_else(|| {
+                Error::input(
+                    source,
+                    format!("object {}: collision hulls enclose no volume", o.name),
+                )
+            })?,
+        };
+        if let Some(mass) = o.physical.mass {
+            inertial = inertial.with_mass(mass);
+        }
+        inertial
+            .check()
+            .map_err(|m| Error::input(source, format!("object {}: {m}", o.name)))?;
+        let com = inertial.com;
+        let to_body =
+            Isometry3::from_parts(Translation3::from(-com.coords), UnitQuaternion::identity());
+        let m = to_body.to_homogeneous();
+        let mut visual = o.visual.clone();
+        visual.transform(&m);
+        let geometry = o.geometry.transformed(&m);
+        let hulls: Vec<Hull> = hulls.iter().map(|h| h.transformed(&to_body)).collect();
+        inertial.com = crate::mesh::P3::origin();
+        let pose =
+            Isometry3::from_parts(Translation3::from(com.coords), UnitQuaternion::identity());
+        let mesh_to_body = Similarity {
+            translation: o.to_world.translation - com.coords,
+            ..o.to_world
+        };
+        if inertial.source == VolumeSource::HullUnion && !o.closed {
+            // already explained in the prepare warning
+        }
+        bodies.push(Body {
+            name: o.name.clone(),
+            label: o.label.clone(),
+            pose,
+            composed_pose: pose,
+            mesh_to_body,
+            visual,
+            geometry,
+            hulls,
+            inertial,
+            friction: o.physical.friction.unwrap_or(DEFAULT_FRICTION),
+            fixed: o.physical.fixed,
+            closed: o.closed,
+            warnings,
+        });
+    }
+    let _ = V3::zeros();
+    Ok(Assembly {
+        name: prepared.name.clone(),
+        bodies,
+        decomposer: engine.name().to_string(),
+        scene_to_world: prepared.scene_to_world,
+        warnings: prepared.warnings.clone(),
+    })
+}

@@ -1,0 +1,100 @@
+//! Convex decomposition: each object of a scene becomes a set of convex hulls that a simulator
+//! can collide. Engines sit behind [`Decomposer`], which sees the whole scene (world frame), so a
+//! scene-aware engine can keep hulls off the neighbours. Every engine's output goes through
+//! [`finish`]: at most `max_hulls` hulls per object, at most `max_vertices` vertices per hull,
+//! no degenerate or paper-thin hulls.
+
+mod hull;
+pub mod vhacd;
+
+pub use hull::Hull;
+
+use crate::error::Result;
+use crate::mesh::Mesh;
+
+/// Limits every decomposition meets.
+#[derive(Clone, Debug, PartialEq)]
+pub struct DecomposeOptions {
+    /// Most hulls per object.
+    pub max_hulls: usize,
+    /// Most vertices per hull (PhysX/Isaac accept 64; MuJoCo any).
+    pub max_vertices: usize,
+    /// Hulls thinner than this (m) are dropped: MuJoCo refuses near-flat meshes.
+    pub min_thickness: f64,
+    /// V-HACD voxel resolution along the longest axis.
+    pub resolution: u32,
+    /// V-HACD concavity threshold (relative).
+    pub concavity: f64,
+}
+
+impl Default for DecomposeOptions {
+    fn default() -> Self {
+        DecomposeOptions {
+            max_hulls: 32,
+            max_vertices: 64,
+            min_thickness: 2e-4,
+            resolution: 64,
+            concavity: 0.01,
+        }
+    }
+}
+
+/// A convex decomposition engine.
+pub trait Decomposer: Send + Sync {
+    /// Short name, recorded in reports.
+    fn name(&self) -> &'static str;
+    /// Hulls for every object of the scene (`objects` in the world frame, metres), in order.
+    fn decompose(&self, objects: &[&Mesh], opts: &DecomposeOptions) -> Result<Vec<Vec<Hull>>>;
+}
+
+/// Bring raw hull point sets within the limits: build hulls, drop degenerate ones, merge down to
+/// `max_hulls` (cheapest merges first), then simplify each to `max_vertices`.
+pub fn finish(raw: Vec<Vec<crate::mesh::P3>>, opts: &DecomposeOptions) -> Vec<Hull> {
+    let mut hulls: Vec<Hull> = raw
+        .iter()
+        .filter_map(|pts| Hull::from_points(pts))
+        .filter(|h| h.thickness() >= opts.min_thickness)
+        .collect();
+    merge_down(&mut hulls, opts.max_hulls);
+    hulls
+        .into_iter()
+        .filter_map(|h| h.simplified(opts.max_vertices))
+        .filter(|h| h.thickness() >= opts.min_thickness)
+        .collect()
+}
+
+/// Merge hulls pairwise until at most `max` remain, each time the pair whose merged hull adds
+/// the least volume. Deterministic (ties broken by index).
+fn merge_down(hulls: &mut Vec<Hull>, max: usize) {
+    while hulls.len() > max.max(1) {
+        let mut best: Option<(f64, usize, usize, Hull)> = None;
+        for i in 0..hulls.len() {
+            for j in i + 1..hulls.len() {
+                let gap = hulls[i].aabb.union(&hulls[j].aabb).diagonal();
+                // Cheap lower bound first: skip pairs that cannot beat the best.
+                if let Some((cost, ..)) = &best {
+                    if *cost <= 0.0 && gap > 0.0 {
+                        continue;
+                    }
+                }
+                let mut pts = hulls[i].vertices.clone();
+                pts.extend_from_slice(&hulls[j].vertices);
+                if let Some(m) = Hull::from_points(&pts) {
+                    let cost = m.volume - hulls[i].volume - hulls[j].volume;
+                    if best.as_ref().is_none_or(|b| cost < b.0) {
+                        best = Some((cost, i, j, m));
+                    }
+                }
+            }
+        }
+        match best {
+            Some((_, i, j, m)) => {
+                hulls.remove(j);
+                hulls[i] = m;
+            }
+            None => {
+                hulls.truncate(max);
+            }
+        }
+    }
+}

@@ -1,0 +1,339 @@
+//! glTF 2.0 reader (`.glb` and `.gltf` with embedded, external or `data:` buffers).
+//!
+//! All nodes of the default scene (or of every scene when none is marked default) are walked
+//! with their transforms composed; every triangle primitive becomes a [`VisualPart`] with its
+//! UVs and base-colour material. Buffer and image URIs are resolved by us, not by the `gltf`
+//! crate, so that none can reach outside the scene folder.
+
+use crate::error::{Error, Result};
+use crate::io::{resolve_inside, texture, Limits};
+use crate::mesh::{Material, Texture, VisualMesh, VisualPart, P3};
+use base64::Engine;
+use gltf::mesh::Mode;
+use nalgebra::Matrix4;
+use std::collections::BTreeMap;
+use std::path::Path;
+
+/// Extensions whose data we cannot decode: a file that requires one is refused by name.
+const UNSUPPORTED_REQUIRED: &[(&str, &str)] = &[
+    ("KHR_draco_mesh_compression", "Draco mesh compression"),
+    ("EXT_meshopt_compression", "meshopt compression"),
+    ("KHR_mesh_quantization", "quantized vertex attributes"),
+    ("KHR_texture_basisu", "Basis Universal textures"),
+    ("EXT_texture_webp", "WebP textures"),
+];
+
+/// Load a `.glb` or `.gltf` file.
+pub fn load(path: &Path, limits: &Limits) -> Result<VisualMesh> {
+    let bytes = crate::io::read_file(path, limits)?;
+    load_bytes(
+        path,
+        &bytes,
+        path.parent().unwrap_or(Path::new(".")),
+        limits,
+    )
+}
+
+/// Load glTF from bytes; `path` names the file in errors and is where relative URIs start from;
+/// `root` is the folder no URI may leave.
+pub fn load_bytes(path: &Path, bytes: &[u8], root: &Path, limits: &Limits) -> Result<VisualMesh> {
+    let err = |m: String| Error::input(path, m);
+    // The JSON is checked for extensions before the gltf crate validates (it rejects Draco with
+    // a less helpful message).
+    let gltf = gltf::Gltf::from_slice_without_validation(bytes).map_err(|e| err(describe(e)))?;
+    for ext in gltf.document.extensions_required() {
+        if let Some((_, what)) = UNSUPPORTED_REQUIRED.iter().find(|(n, _)| *n == ext) {
+            return Err(err(format!(
+                "requires the glTF extension {ext} ({what}), which interact3d does not support; \
+                 re-export the file without it"
+            )));
+        }
+    }
+    let gltf = gltf::Gltf::from_slice(bytes).map_err(|e| err(describe(e)))?;
+    let doc = &gltf.document;
+
+    // Buffers.
+    let mut blob = gltf.blob.clone();
+    let mut buffers: Vec<Vec<u8>> = Vec::new();
+    for buffer in doc.buffers() {
+        let data = match buffer.source() {
+            gltf::buffer::Source::Bin => blob.take().ok_or_else(|| {
+                err("buffer refers to the GLB binary chunk, which is missing".into())
+            })?,
+            gltf::buffer::Source::Uri(uri) => read_uri(path, root, uri, limits)?,
+        };
+        if data.len() < buffer.length() {
+            return Err(err(format!(
+                "buffer {} is {} bytes, shorter than its declared length {}",
+                buffer.index(),
+                data.len(),
+                buffer.length()
+            )));
+        }
+        buffers.push(data);
+    }
+    // Every accessor must fit inside its buffer view and buffer before the reader touches it.
+    for acc in doc.accessors() {
+        check_accessor(&acc, &buffers)
+            .map_err(|m| err(format!("accessor {}: {m}", acc.index())))?;
+    }
+
+    let scenes: Vec<_> = match doc.default_scene() {
+        Some(s) => vec![s],
+        None => doc.scenes().collect(),
+    };
+    let mut textures: BTreeMap<usize, Texture> = BTreeMap::new();
+    let mut parts = Vec::new();
+    let mut stack: Vec<(gltf::Node, Matrix4<f64>)> = Vec::new();
+    for scene in scenes {
+        for node in scene.nodes() {
+            stack.push((node, Matrix4::identity()));
+        }
+    }
+    let mut visited = 0usize;
+    while let Some((node, parent)) = stack.pop() {
+        visited += 1;
+        if visited > 1_000_000 {
+            return Err(err("node hierarchy too deep or cyclic".into()));
+        }
+        let local = Matrix4::from_fn(|i, j| node.transform().matrix()[j][i] as f64);
+        let world = parent * local;
+        if let Some(mesh) = node.mesh() {
+            for prim in mesh.primitives() {
+                if let Some(part) =
+                    read_primitive(path, root, &prim, &buffers, &world, &mut textures, limits)?
+                {
+                    parts.push(part);
+                }
+            }
+        }
+        for child in node.children() {
+            stack.push((child, world));
+        }
+    }
+    Ok(VisualMesh { parts })
+}
+
+fn describe(e: gltf::Error) -> String {
+    match e {
+        gltf::Error::Validation(v) => {
+            let list: Vec<String> = v.iter().take(3).map(|(p, e)| format!("{p}: {e}")).collect();
+            format!("invalid glTF: {}", list.join("; "))
+        }
+        gltf::Error::Binary(b) => format!("corrupt GLB container: {b:?}"),
+        gltf::Error::Deserialize(d) => format!("corrupt glTF JSON: {d}"),
+        other => format!("cannot read glTF: {other}"),
+    }
+}
+
+fn read_uri(path: &Path, root: &Path, uri: &str, limits: &Limits) -> Result<Vec<u8>> {
+    if let Some(rest) = uri.strip_prefix("data:") {
+        let (_, data) = rest
+            .split_once(";base64,")
+            .ok_or_else(|| Error::input(path, "data: URI is not base64-encoded"))?;
+        if data.len() as u64 / 4 * 3 > limits.max_file_bytes {
+            return Err(Error::input(path, "data: URI is over the file size limit"));
+        }
+        return base64::engine::general_purpose::STANDARD
+            .decode(data.trim())
+            .map_err(|e| Error::input(path, format!("data: URI is not valid base64: {e}")));
+    }
+    let decoded = percent_decode(uri);
+    let file = resolve_inside(root, path, &decoded)?;
+    crate::io::read_file(&file, limits)
+}
+
+fn percent_decode(s: &str) -> String {
+    let b = s.as_bytes();
+    let mut out = Vec::with_capacity(b.len());
+    let mut i = 0;
+    while i < b.len() {
+        if b[i] == b'%' && i + 2 < b.len() {
+            if let Ok(v) = u8::from_str_radix(&s[i + 1..i + 3], 16) {
+                out.push(v);
+                i += 3;
+                continue;
+            }
+        }
+        out.push(b[i]);
+        i += 1;
+    }
+    String::from_utf8_lossy(&out).into_owned()
+}
+
+fn check_accessor(acc: &gltf::Accessor, buffers: &[Vec<u8>]) -> std::result::Result<(), String> {
+    if acc.sparse().is_some() {
+        return Err("sparse accessors are not supported".into());
+    }
+    let Some(view) = acc.view() else {
+        return Ok(());
+    };
+    let buf_len = buffers
+        .get(view.buffer().index())
+        .map(|b| b.len())
+        .ok_or("buffer index out of range")?;
+    let view_end = view
+        .offset()
+        .checked_add(view.length())
+        .ok_or("view size overflows")?;
+    if view_end > buf_len {
+        return Err(format!(
+            "buffer view {} runs past the end of its buffer ({view_end} > {buf_len})",
+            view.index()
+        ));
+    }
+    let elem = acc.size();
+    let stride = view.stride().unwrap_or(elem);
+    if acc.count() > 0 {
+        let need = acc
+            .offset()
+            .checked_add(
+                (acc.count() - 1)
+                    .checked_mul(stride)
+                    .ok_or("count overflows")?,
+            )
+            .and_then(|x| x.checked_add(elem))
+            .ok_or("size overflows")?;
+        if need > view.length() {
+            return Err(format!(
+                "{} elements need {need} bytes, more than its buffer view's {}",
+                acc.count(),
+                view.length()
+            ));
+        }
+    }
+    Ok(())
+}
+
+fn read_primitive(
+    path: &Path,
+    root: &Path,
+    prim: &gltf::Primitive,
+    buffers: &[Vec<u8>],
+    world: &Matrix4<f64>,
+    textures: &mut BTreeMap<usize, Texture>,
+    limits: &Limits,
+) -> Result<Option<VisualPart>> {
+    let err = |m: String| Error::input(path, m);
+    let mode = prim.mode();
+    if !matches!(
+        mode,
+        Mode::Triangles | Mode::TriangleStrip | Mode::TriangleFan
+    ) {
+        return Ok(None); // points and lines carry no surface
+    }
+    let reader = prim.reader(|b| buffers.get(b.index()).map(|d| d.as_slice()));
+    let positions: Vec<P3> = reader
+        .read_positions()
+        .ok_or_else(|| err("primitive has no POSITION attribute".into()))?
+        .map(|p| world.transform_point(&P3::new(p[0] as f64, p[1] as f64, p[2] as f64)))
+        .collect();
+    let n = positions.len() as u32;
+    let flat: Vec<u32> = match reader.read_indices() {
+        Some(ix) => ix.into_u32().collect(),
+        None => (0..n).collect(),
+    };
+    if let Some(bad) = flat.iter().find(|&&i| i >= n) {
+        return Err(err(format!("index {bad} past the vertex count {n}")));
+    }
+    let mut triangles: Vec<[u32; 3]> = match mode {
+        Mode::Triangles => flat.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect(),
+        Mode::TriangleStrip => (2..flat.len())
+            .map(|i| {
+                if i % 2 == 0 {
+                    [flat[i - 2], flat[i - 1], flat[i]]
+                } else {
+                    [flat[i - 1], flat[i - 2], flat[i]]
+                }
+            })
+            .collect(),
+        _ => (2..flat.len())
+            .map(|i| [flat[0], flat[i - 1], flat[i]])
+            .collect(),
+    };
+    if world.fixed_view::<3, 3>(0, 0).determinant() < 0.0 {
+        for t in &mut triangles {
+            t.swap(1, 2);
+        }
+    }
+    let mat = prim.material();
+    let pbr = mat.pbr_metallic_roughness();
+    let f = pbr.base_color_factor();
+    let mut material = Material {
+        name: mat
+            .name()
+            .map(str::to_string)
+            .unwrap_or_else(|| match mat.index() {
+                Some(i) => format!("material_{i}"),
+                None => "default".into(),
+            }),
+        base_color: [f[0] as f64, f[1] as f64, f[2] as f64, f[3] as f64],
+        texture: None,
+    };
+    let mut uvs = None;
+    if let Some(info) = pbr.base_color_texture() {
+        let set = info.tex_coord();
+        if let Some(tc) = reader.read_tex_coords(set) {
+            let mut uv: Vec<[f64; 2]> = tc.into_f32().map(|t| [t[0] as f64, t[1] as f64]).collect();
+            if uv.len() != positions.len() {
+                return Err(err("TEXCOORD count does not match POSITION count".into()));
+            }
+            if let Some(tt) = info.texture_transform() {
+                apply_texture_transform(&mut uv, tt.offset(), tt.rotation(), tt.scale());
+            }
+            let image = info.texture().source();
+            let tex = match textures.get(&image.index()) {
+                Some(t) => t.clone(),
+                None => {
+                    let t = read_image(path, root, &image, buffers, limits)?;
+                    textures.insert(image.index(), t.clone());
+                    t
+                }
+            };
+            material.texture = Some(tex);
+            uvs = Some(uv);
+        }
+    }
+    Ok(Some(VisualPart {
+        positions,
+        uvs,
+        triangles,
+        material,
+    }))
+}
+
+fn apply_texture_transform(uv: &mut [[f64; 2]], offset: [f32; 2], rotation: f32, scale: [f32; 2]) {
+    let (s, c) = (rotation as f64).sin_cos();
+    for t in uv.iter_mut() {
+        let (u, v) = (t[0] * scale[0] as f64, t[1] * scale[1] as f64);
+        *t = [
+            c * u + s * v + offset[0] as f64,
+            -s * u + c * v + offset[1] as f64,
+        ];
+    }
+}
+
+fn read_image(
+    path: &Path,
+    root: &Path,
+    image: &gltf::Image,
+    buffers: &[Vec<u8>],
+    limits: &Limits,
+) -> Result<Texture> {
+    let origin = format!("{}#image{}", path.display(), image.index());
+    let bytes = match image.source() {
+        gltf::image::Source::View { view, .. } => {
+            let buf = &buffers[view.buffer().index()];
+            let end = view.offset() + view.length();
+            if end > buf.len() {
+                return Err(Error::input(
+                    &origin,
+                    "image buffer view runs past the end of its buffer",
+                ));
+            }
+            buf[view.offset()..end].to_vec()
+        }
+        gltf::image::Source::Uri { uri, .. } => read_uri(path, root, uri, limits)?,
+    };
+    texture::from_bytes(&origin, bytes, limits)
+}

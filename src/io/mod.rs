@@ -1,0 +1,202 @@
+//! File formats: mesh readers (glTF/GLB, OBJ+MTL, STL), texture reading, and the writers the
+//! export and the fixtures use. Readers check what they read and name the file in every error.
+
+pub mod gltf;
+pub mod obj;
+pub mod stl;
+pub mod texture;
+
+use crate::error::{Error, Result};
+use crate::mesh::VisualMesh;
+use std::path::{Component, Path, PathBuf};
+
+/// Size limits applied while reading, so a hostile file cannot make us allocate gigabytes.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Limits {
+    /// Largest file read, bytes.
+    pub max_file_bytes: u64,
+    /// Most triangles in one mesh file.
+    pub max_triangles: usize,
+    /// Most pixels in one texture.
+    pub max_texture_pixels: u64,
+}
+
+impl Default for Limits {
+    fn default() -> Self {
+        Limits {
+            max_file_bytes: 2 << 30,
+            max_triangles: 20_000_000,
+            max_texture_pixels: 16384 * 16384,
+        }
+    }
+}
+
+/// Read a whole file, refusing files over the limit.
+pub fn read_file(path: &Path, limits: &Limits) -> Result<Vec<u8>> {
+    let meta = std::fs::metadata(path).map_err(|e| Error::io(path, e))?;
+    if !meta.is_file() {
+        return Err(Error::input(path, "not a regular file"));
+    }
+    if meta.len() > limits.max_file_bytes {
+        return Err(Error::input(
+            path,
+            format!(
+                "file is {} bytes, over the limit of {} bytes",
+                meta.len(),
+                limits.max_file_bytes
+            ),
+        ));
+    }
+    std::fs::read(path).map_err(|e| Error::io(path, e))
+}
+
+/// Load a visual mesh by extension: `.glb`, `.gltf`, `.obj`, `.stl`.
+pub fn load_visual(path: &Path, limits: &Limits) -> Result<VisualMesh> {
+    let ext = path
+        .extension()
+        .and_then(|e| e.to_str())
+        .map(|e| e.to_ascii_lowercase())
+        .unwrap_or_default();
+    let mesh = match ext.as_str() {
+        "glb" | "gltf" => gltf::load(path, limits)?,
+        "obj" => obj::load(path, limits)?,
+        "stl" => stl::load(path, limits)?,
+        _ => {
+            return Err(Error::input(
+                path,
+                "unsupported mesh format (expected .glb, .gltf, .obj or .stl)",
+            ))
+        }
+    };
+    check_visual(path, &mesh, limits)?;
+    Ok(mesh)
+}
+
+/// The checks every loaded mesh passes: finite, sane coordinates, valid indices, not empty.
+pub fn check_visual(path: &Path, mesh: &VisualMesh, limits: &Limits) -> Result<()> {
+    let tris = mesh.triangle_count();
+    if tris == 0 {
+        return Err(Error::input(path, "mesh has no triangles"));
+    }
+    if tris > limits.max_triangles {
+        return Err(Error::input(
+            path,
+            format!(
+                "mesh has {tris} triangles, over the limit of {}",
+                limits.max_triangles
+            ),
+        ));
+    }
+    for part in &mesh.parts {
+        if let Some(p) = part
+            .positions
+            .iter()
+            .find(|p| !p.iter().all(|c| c.is_finite()))
+        {
+            return Err(Error::input(
+                path,
+                format!("vertex with a NaN or infinite coordinate: {p:?}"),
+            ));
+        }
+        if let Some(p) = part
+            .positions
+            .iter()
+            .find(|p| p.iter().any(|c| c.abs() > 1e12))
+        {
+            return Err(Error::input(
+                path,
+                format!(
+                    "vertex coordinate out of range (|x| > 1e12): [{}, {}, {}]",
+                    p.x, p.y, p.z
+                ),
+            ));
+        }
+        let n = part.positions.len() as u32;
+        if let Some(t) = part.triangles.iter().find(|t| t.iter().any(|&i| i >= n)) {
+            return Err(Error::input(
+                path,
+                format!("triangle index {t:?} past the vertex count {n}"),
+            ));
+        }
+        if let Some(uvs) = &part.uvs {
+            if uvs.len() != part.positions.len() {
+                return Err(Error::input(
+                    path,
+                    "texture coordinates do not match vertex count",
+                ));
+            }
+        }
+    }
+    if mesh.geometry().area() <= 0.0 {
+        return Err(Error::input(
+            path,
+            "mesh has only degenerate (zero-area) triangles",
+        ));
+    }
+    Ok(())
+}
+
+/// Resolve `rel` (a path found inside `from_file`) against the folder of `from_file`, refusing
+/// anything that leaves `root`: absolute paths, `..` that climbs out, URIs with a scheme, and
+/// symbolic links that point outside.
+pub fn resolve_inside(root: &Path, from_file: &Path, rel: &str) -> Result<PathBuf> {
+    let bad = |why: &str| Error::input(from_file, format!("reference {rel:?} {why}"));
+    if rel.is_empty() {
+        return Err(bad("is empty"));
+    }
+    if rel.contains("://") || rel.starts_with("file:") {
+        return Err(bad(
+            "is a URI; only relative paths inside the scene folder are allowed",
+        ));
+    }
+    let relp = Path::new(rel);
+    if relp.is_absolute() || rel.starts_with('/') || rel.starts_with('\\') || rel.contains(':') {
+        return Err(bad(
+            "is an absolute path; only relative paths inside the scene folder are allowed",
+        ));
+    }
+    let base = from_file.parent().unwrap_or(Path::new("."));
+    let mut joined = base.to_path_buf();
+    for c in relp.components() {
+        match c {
+            Component::Normal(s) => joined.push(s),
+            Component::CurDir => {}
+            Component::ParentDir => {
+                if !joined.pop() {
+                    return Err(bad("climbs out of the scene folder"));
+                }
+            }
+            _ => return Err(bad("is not a plain relative path")),
+        }
+    }
+    let root_c = root.canonicalize().map_err(|e| Error::io(root, e))?;
+    // Lexical check first (clear message), then the real one through symlinks.
+    let lexical = normalize(&joined);
+    if !lexical.starts_with(normalize(root)) && !lexical.starts_with(&root_c) {
+        return Err(bad("points outside the scene folder"));
+    }
+    match joined.canonicalize() {
+        Ok(real) if !real.starts_with(&root_c) => {
+            Err(bad("resolves (through a link) outside the scene folder"))
+        }
+        Ok(real) => Ok(real),
+        Err(e) => Err(Error::input(
+            from_file,
+            format!("reference {rel:?}: cannot open {}: {e}", joined.display()),
+        )),
+    }
+}
+
+fn normalize(p: &Path) -> PathBuf {
+    let mut out = PathBuf::new();
+    for c in p.components() {
+        match c {
+            Component::CurDir => {}
+            Component::ParentDir => {
+                out.pop();
+            }
+            c => out.push(c),
+        }
+    }
+    out
+}

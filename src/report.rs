@@ -1,0 +1,94 @@
+//! `report.json`: what export computed for each object, and the validation verdict.
+//! Field names and order are part of the documented schema (README).
+
+use crate::body::Assembly;
+use crate::export::format::round;
+use crate::inertia::VolumeSource;
+use serde::Serialize;
+
+/// The whole report.
+#[derive(Clone, Debug, Serialize)]
+pub struct Report {
+    /// Always "interact3d".
+    pub tool: &'static str,
+    pub version: &'static str,
+    pub scene: String,
+    /// Convex decomposition engine.
+    pub decomposer: String,
+    /// Metres per scene unit applied by preparation (units and `--size`).
+    pub scale: f64,
+    pub objects: Vec<ObjectReport>,
+    pub warnings: Vec<String>,
+    /// Present when validation ran.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub validation: Option<serde_json::Value>,
+}
+
+/// One object.
+#[derive(Clone, Debug, Serialize)]
+pub struct ObjectReport {
+    pub name: String,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub label: Option<String>,
+    /// kg
+    pub mass: f64,
+    /// Centre of mass in the world at the composed pose (m).
+    pub com: [f64; 3],
+    /// Inertia tensor about the centre of mass, world axes (kg·m²).
+    pub inertia: [[f64; 3]; 3],
+    /// m³
+    pub volume: f64,
+    pub volume_source: VolumeSource,
+    pub closed: bool,
+    pub triangles: usize,
+    /// World bounding box extents at the composed pose (m).
+    pub extents: [f64; 3],
+    pub hull_count: usize,
+    pub hull_vertex_counts: Vec<usize>,
+    pub fixed: bool,
+    pub friction: f64,
+    pub warnings: Vec<String>,
+}
+
+impl Report {
+    /// The report of an assembly (no validation yet).
+    pub fn new(a: &Assembly) -> Report {
+        let objects = a
+            .bodies
+            .iter()
+            .map(|b| {
+                let com = b.composed_pose.translation.vector;
+                let ext = b.geometry.aabb().map(|x| x.extents()).unwrap_or_default();
+                ObjectReport {
+                    name: b.name.clone(),
+                    label: b.label.clone(),
+                    mass: round(b.inertial.mass),
+                    com: [round(com.x), round(com.y), round(com.z)],
+                    inertia: std::array::from_fn(|r| {
+                        std::array::from_fn(|c| round(b.inertial.inertia[(r, c)]))
+                    }),
+                    volume: round(b.inertial.volume),
+                    volume_source: b.inertial.source,
+                    closed: b.closed,
+                    triangles: b.visual.triangle_count(),
+                    extents: [round(ext.x), round(ext.y), round(ext.z)],
+                    hull_count: b.hulls.len(),
+                    hull_vertex_counts: b.hulls.iter().map(|h| h.vertices.len()).collect(),
+                    fixed: b.fixed,
+                    friction: round(b.friction),
+                    warnings: b.warnings.clone(),
+                }
+            })
+            .collect();
+        Report {
+            tool: "interact3d",
+            version: env!("CARGO_PKG_VERSION"),
+            scene: a.name.clone(),
+            decomposer: a.decomposer.clone(),
+            scale: round(a.scene_to_world.scale),
+            objects,
+            warnings: a.warnings.clone(),
+            validation: None,
+        }
+    }
+}

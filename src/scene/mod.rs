@@ -1,0 +1,121 @@
+//! Scenes as they come in: an Interact3D sample folder or our own `scene.json` manifest, each
+//! loaded into the same [`Scene`]: named objects, each a visual mesh in its own frame plus the
+//! similarity that places it in the scene.
+
+pub mod manifest;
+pub mod sample;
+
+use crate::error::{Error, Result};
+use crate::io::Limits;
+use crate::mesh::VisualMesh;
+use crate::pose::Similarity;
+use std::path::{Path, PathBuf};
+
+/// Which axis points up in a scene's frame.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum UpAxis {
+    Y,
+    Z,
+}
+
+/// Physical properties given for an object (all optional but `fixed`).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Physical {
+    /// kg/m³; the default density applies when neither this nor `mass` is given.
+    pub density: Option<f64>,
+    /// kg; overrides density.
+    pub mass: Option<f64>,
+    pub friction: Option<f64>,
+    /// A static object (no free joint, not moved by the simulation).
+    pub fixed: bool,
+}
+
+/// One object of a scene.
+#[derive(Clone, Debug)]
+pub struct SceneObject {
+    /// Identifier, unique in the scene: `[A-Za-z_][A-Za-z0-9_-]*`.
+    pub name: String,
+    /// Human label (e.g. "bowl") when the input has one.
+    pub label: Option<String>,
+    /// The mesh file it was read from.
+    pub mesh_path: PathBuf,
+    /// Geometry and materials in the mesh's own frame.
+    pub visual: VisualMesh,
+    /// Mesh frame → scene frame (scene units, scene up axis).
+    pub pose: Similarity,
+    pub physical: Physical,
+}
+
+/// A scene as read from disk, before any preparation.
+#[derive(Clone, Debug)]
+pub struct Scene {
+    /// Name (the folder or manifest name).
+    pub name: String,
+    /// The folder or manifest it came from.
+    pub source: PathBuf,
+    /// Metres per scene unit.
+    pub meters_per_unit: f64,
+    pub up_axis: UpAxis,
+    pub objects: Vec<SceneObject>,
+    /// Notes from loading that do not stop it.
+    pub warnings: Vec<String>,
+}
+
+/// Load a scene from a sample folder (with `metadata.json`), a folder with `scene.json`, or a
+/// manifest file.
+pub fn load(path: &Path, limits: &Limits) -> Result<Scene> {
+    if path.is_dir() {
+        if path.join("scene.json").is_file() {
+            manifest::load(&path.join("scene.json"), limits)
+        } else if path.join("metadata.json").is_file() {
+            sample::load(path, limits)
+        } else {
+            Err(Error::input(
+                path,
+                "not a scene: the folder has neither scene.json nor metadata.json",
+            ))
+        }
+    } else if path.is_file() {
+        match path.file_name().and_then(|n| n.to_str()) {
+            Some("metadata.json") => sample::load(path.parent().unwrap_or(Path::new(".")), limits),
+            _ => manifest::load(path, limits),
+        }
+    } else {
+        Err(Error::input(path, "no such file or folder"))
+    }
+}
+
+/// Whether `name` is usable as an identifier in MJCF, URDF and file names.
+pub fn is_valid_name(name: &str) -> bool {
+    let mut chars = name.chars();
+    matches!(chars.next(), Some(c) if c.is_ascii_alphabetic() || c == '_')
+        && chars.all(|c| c.is_ascii_alphanumeric() || c == '_' || c == '-')
+        && name.len() <= 64
+}
+
+/// Check names: valid and unique.
+pub(crate) fn check_names(source: &Path, objects: &[SceneObject]) -> Result<()> {
+    let mut seen = std::collections::BTreeSet::new();
+    for o in objects {
+        if !is_valid_name(&o.name) {
+            return Err(Error::input(
+                source,
+                format!(
+                    "object name {:?} is not a valid identifier (letters, digits, '_' and '-', starting with a letter or '_', at most 64)",
+                    o.name
+                ),
+            ));
+        }
+        if !seen.insert(o.name.as_str()) {
+            return Err(Error::input(
+                source,
+                format!("duplicate object name {:?}", o.name),
+            ));
+        }
+    }
+    if objects.is_empty() {
+        return Err(Error::input(source, "scene has no objects"));
+    }
+    Ok(())
+}
