@@ -77,13 +77,85 @@ pub fn load(path: &Path, limits: &Limits) -> Result<Scene> {
             ))
         }
     } else if path.is_file() {
-        match path.file_name().and_then(|n| n.to_str()) {
-            Some("metadata.json") => sample::load(path.parent().unwrap_or(Path::new(".")), limits),
+        let ext = path
+            .extension()
+            .and_then(|e| e.to_str())
+            .map(|e| e.to_ascii_lowercase());
+        match (path.file_name().and_then(|n| n.to_str()), ext.as_deref()) {
+            (Some("metadata.json"), _) => {
+                sample::load(path.parent().unwrap_or(Path::new(".")), limits)
+            }
+            (_, Some("glb" | "gltf" | "obj" | "stl")) => single_mesh(path, limits),
             _ => manifest::load(path, limits),
         }
     } else {
         Err(Error::input(path, "no such file or folder"))
     }
+}
+
+/// A lone mesh file as a one-object scene: identity pose, metres, Y-up for glTF (its
+/// convention), Z-up otherwise (OBJ/STL from robotics and scanning usually are).
+pub fn single_mesh(path: &Path, limits: &Limits) -> Result<Scene> {
+    let visual = crate::io::load_visual(path, limits)?;
+    let stem = path
+        .file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    // Scanned-object datasets call every file model.obj or textured.obj: use the folder's name.
+    let generic = ["model", "textured", "mesh", "scene", "visual"]
+        .contains(&stem.to_ascii_lowercase().as_str());
+    let folder = path.canonicalize().ok().and_then(|p| {
+        p.parent()
+            .and_then(|d| d.file_name())
+            .map(|n| n.to_string_lossy().into_owned())
+    });
+    let name = sanitize_name(match (&folder, generic) {
+        (Some(f), true) => f,
+        _ => &stem,
+    });
+    let ext = path
+        .extension()
+        .and_then(|e| e.to_str())
+        .map(|e| e.to_ascii_lowercase());
+    Ok(Scene {
+        name: name.clone(),
+        source: path.to_path_buf(),
+        meters_per_unit: 1.0,
+        up_axis: if matches!(ext.as_deref(), Some("glb" | "gltf")) {
+            UpAxis::Y
+        } else {
+            UpAxis::Z
+        },
+        objects: vec![SceneObject {
+            name,
+            label: None,
+            mesh_path: path.to_path_buf(),
+            visual,
+            pose: Similarity::identity(),
+            physical: Physical::default(),
+        }],
+        warnings: Vec::new(),
+    })
+}
+
+/// Turn any text into a valid object name (used for names taken from file names).
+pub fn sanitize_name(s: &str) -> String {
+    let mut out: String = s
+        .chars()
+        .map(|c| {
+            if c.is_ascii_alphanumeric() || c == '_' || c == '-' {
+                c
+            } else {
+                '_'
+            }
+        })
+        .take(64)
+        .collect();
+    if !out.starts_with(|c: char| c.is_ascii_alphabetic() || c == '_') {
+        out.insert(0, '_');
+        out.truncate(64);
+    }
+    out
 }
 
 /// Whether `name` is usable as an identifier in MJCF, URDF and file names.

@@ -1,0 +1,104 @@
+//! Helpers shared by the integration tests.
+#![allow(dead_code)]
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+/// The repository root.
+pub fn root() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+}
+
+/// `../shared` beside the repository (CI has it there).
+pub fn shared() -> PathBuf {
+    root().join("..").join("shared")
+}
+
+/// Run the `interact3d` binary; returns (exit code, stdout, stderr).
+pub fn run(args: &[&str]) -> (i32, String, String) {
+    let out = Command::new(env!("CARGO_BIN_EXE_interact3d"))
+        .args(args)
+        .output()
+        .expect("run interact3d");
+    (
+        out.status.code().unwrap_or(-1),
+        String::from_utf8_lossy(&out.stdout).into_owned(),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    )
+}
+
+/// Export `scene` to `out` with the binary, panicking with its stderr on failure.
+pub fn export(scene: &Path, out: &Path, extra: &[&str]) {
+    let mut args = vec![
+        "export",
+        scene.to_str().unwrap(),
+        "-o",
+        out.to_str().unwrap(),
+    ];
+    args.extend_from_slice(extra);
+    let (code, _, err) = run(&args);
+    assert_eq!(code, 0, "export {} failed: {err}", scene.display());
+}
+
+/// The Python interpreter for the interoperability tests.
+pub fn python() -> String {
+    std::env::var("INTERACT3D_PYTHON").unwrap_or_else(|_| "python3".into())
+}
+
+/// Run one of tests/python/*.py and parse its JSON output.
+pub fn python_json(script: &str, args: &[&str]) -> serde_json::Value {
+    let out = Command::new(python())
+        .arg(root().join("tests/python").join(script))
+        .args(args)
+        .output()
+        .expect("python3 must be installed (see .ci/run)");
+    assert!(
+        out.status.success(),
+        "{script} {args:?} failed (install the packages in tests/python/requirements.txt):\n{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    serde_json::from_slice(&out.stdout).unwrap_or_else(|e| {
+        panic!(
+            "{script}: bad JSON ({e}): {}",
+            String::from_utf8_lossy(&out.stdout)
+        )
+    })
+}
+
+/// Read a JSON file.
+pub fn read_json(path: &Path) -> serde_json::Value {
+    serde_json::from_slice(&std::fs::read(path).unwrap()).unwrap()
+}
+
+/// Every fixture folder (holding metadata.json or scene.json).
+pub fn fixtures() -> Vec<PathBuf> {
+    let mut v: Vec<PathBuf> = std::fs::read_dir(root().join("fixtures"))
+        .map(|it| {
+            it.filter_map(|e| e.ok())
+                .map(|e| e.path())
+                .filter(|p| p.join("metadata.json").is_file() || p.join("scene.json").is_file())
+                .collect()
+        })
+        .unwrap_or_default();
+    v.sort();
+    v
+}
+
+/// Every composed scene in ../shared/datasets/scenes.
+pub fn shared_scenes() -> Vec<PathBuf> {
+    let base = shared().join("datasets/scenes");
+    let mut v = Vec::new();
+    if let Ok(cats) = std::fs::read_dir(&base) {
+        for c in cats.filter_map(|e| e.ok()) {
+            if let Ok(sc) = std::fs::read_dir(c.path()) {
+                v.extend(
+                    sc.filter_map(|e| e.ok())
+                        .map(|e| e.path())
+                        .filter(|p| p.join("metadata.json").is_file()),
+                );
+            }
+        }
+    }
+    v.sort();
+    v
+}
