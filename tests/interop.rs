@@ -71,6 +71,43 @@ fn check_engines(scene: &Path, extra: &[&str]) {
         }
     }
 
+    // Every URDF parses with urdf-rs and, where installed (CI installs it), ROS's check_urdf.
+    let have_check_urdf = std::process::Command::new("check_urdf")
+        .arg("--help")
+        .output()
+        .is_ok();
+    assert!(
+        have_check_urdf || std::env::var("CI").is_err(),
+        "CI must have check_urdf (liburdfdom-tools)"
+    );
+    for o in objects {
+        let urdf = out.join(format!("{}.urdf", o["name"].as_str().unwrap()));
+        let robot = urdf_rs::read_file(&urdf).unwrap_or_else(|e| panic!("{}: {e}", urdf.display()));
+        assert_eq!(robot.links.len(), 1);
+        assert_eq!(
+            robot.links[0].collision.len() as u64,
+            o["hull_count"].as_u64().unwrap()
+        );
+        assert!(
+            rel(
+                robot.links[0].inertial.mass.value,
+                o["mass"].as_f64().unwrap()
+            ) < 1e-6
+        );
+        if have_check_urdf {
+            let r = std::process::Command::new("check_urdf")
+                .arg(&urdf)
+                .output()
+                .unwrap();
+            assert!(
+                r.status.success()
+                    && String::from_utf8_lossy(&r.stdout).contains("Successfully Parsed"),
+                "check_urdf {}",
+                urdf.display()
+            );
+        }
+    }
+
     let pb = python_json("check_pybullet.py", &[outs]);
     assert_eq!(
         pb["finite"],
