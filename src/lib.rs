@@ -7,6 +7,7 @@
 //! [`export`] (MJCF, URDF) → [`metrics`] and [`physics`] (validation).
 
 pub mod error;
+pub mod io;
 pub mod mesh;
 pub mod pose;
 pub mod shapes;
