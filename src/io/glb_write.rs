@@ -445,8 +445,8 @@ mod tests {
             let mat = prim.material();
             assert_eq!(mat.name(), Some(part.material.name.as_str()));
             let f = mat.pbr_metallic_roughness().base_color_factor();
-            for i in 0..4 {
-                assert!((f[i] as f64 - part.material.base_color[i]).abs() < 1e-7);
+            for (got, want) in f.iter().zip(part.material.base_color) {
+                assert!((*got as f64 - want).abs() < 1e-7);
             }
             let info = mat.pbr_metallic_roughness().base_color_texture();
             assert_eq!(info.is_some(), part.material.texture.is_some());
