@@ -1,10 +1,13 @@
 //! File formats: mesh readers (glTF/GLB, OBJ+MTL, STL), texture reading, and the writers the
 //! export and the fixtures use. Readers check what they read and name the file in every error.
 
+pub mod glb_write;
 pub mod gltf;
 pub mod obj;
 pub mod stl;
 pub mod texture;
+
+pub use glb_write::{to_glb_bytes, to_glb_bytes_with, write_glb, write_glb_with, GlbOptions};
 
 use crate::error::{Error, Result};
 use crate::mesh::VisualMesh;
