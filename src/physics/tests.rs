@@ -140,21 +140,18 @@ fn box_on_its_edge_topples() {
 
 #[test]
 fn sphere_settles_at_the_bottom_of_a_bowl() {
-    // A generic attitude: settles, sleeps and passes.
-    let r = sphere_in_bowl(UnitQuaternion::from_euler_angles(0.9, 0.2, 0.1));
-    assert!(r.passed, "{:?}", body(&r, "ball").reasons);
-    assert!(r.time_to_sleep.is_some());
-    // Pole vertex down: 32 fan facets within ~1.1° of each other form a nearly flat cone, and
-    // Rapier keeps the ball creeping around it (measured 0.4–4 mm, 1–11° during the 1 s rest
-    // check, depending chaotically on solver settings). It still settles at the bottom and
-    // stays in the bowl; the rest verdict is not asserted.
-    let r = sphere_in_bowl(UnitQuaternion::identity());
-    let b = body(&r, "ball");
-    assert!(
-        b.relative_drift < 0.1 && !b.left_supports,
-        "{:?}",
-        b.reasons
-    );
+    // A generic attitude, and the pole vertex down: 32 fan facets within ~1.1° of each other
+    // form a nearly flat cone. With contact recycling off Rapier keeps the ball creeping around
+    // that cone (measured 0.4–4 mm and 1–11° during the 1 s rest check, depending chaotically
+    // on solver settings); with the default 0.5 mm recycling it rests.
+    for rotation in [
+        UnitQuaternion::from_euler_angles(0.9, 0.2, 0.1),
+        UnitQuaternion::identity(),
+    ] {
+        let r = sphere_in_bowl(rotation);
+        assert!(r.passed, "{:?}", body(&r, "ball").reasons);
+        assert!(r.time_to_sleep.is_some());
+    }
 }
 
 fn sphere_in_bowl(rotation: UnitQuaternion<f64>) -> SettleReport {
