@@ -8,6 +8,7 @@
 
 pub mod error;
 pub mod mesh;
+pub mod metrics;
 pub mod pose;
 pub mod shapes;
 
