@@ -224,11 +224,18 @@ impl Bvh {
         best
     }
 
-    /// Squared distance from `p` to the nearest triangle.
-    pub fn point_dist2(&self, p: V) -> f64 {
+    /// Squared distance from `p` to the nearest triangle, and that triangle. `hint`, a
+    /// triangle likely to be near (e.g. the answer for a neighbouring point), only seeds the
+    /// bound: the result is the exact minimum either way.
+    pub fn nearest(&self, p: V, hint: Option<usize>) -> (f64, usize) {
         let mut best = f64::INFINITY;
+        let mut arg = usize::MAX;
         if self.is_empty() {
-            return best;
+            return (best, arg);
+        }
+        if let Some(h) = hint.filter(|&h| h < self.tris.len()) {
+            best = geom::point_tri_dist2(p, &self.tris[h]);
+            arg = h;
         }
         let mut stack = vec![(0u32, self.nodes[0].bb.point_dist2(p))];
         while let Some((a, d)) = stack.pop() {
@@ -238,7 +245,11 @@ impl Bvh {
             let na = &self.nodes[a as usize];
             if na.count > 0 {
                 for &i in self.leaf(na) {
-                    best = best.min(geom::point_tri_dist2(p, &self.tris[i as usize]));
+                    let d2 = geom::point_tri_dist2(p, &self.tris[i as usize]);
+                    if d2 < best {
+                        best = d2;
+                        arg = i as usize;
+                    }
                 }
                 continue;
             }
@@ -255,7 +266,7 @@ impl Bvh {
                 stack.push(near);
             }
         }
-        best
+        (best, arg)
     }
 }
 

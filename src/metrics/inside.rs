@@ -247,6 +247,15 @@ impl RayMesh {
         self.classify(p, 2, &line, &mut scratch)
     }
 
+    /// Parity of the crossings below `p` along one axis, without any vote (tests only: what
+    /// the vote repairs).
+    #[cfg(test)]
+    pub fn parity_only(&self, p: V, axis: usize) -> bool {
+        let mut line = Vec::new();
+        self.crossings(axis, p, &mut line);
+        line.partition_point(|&t| t < p[axis]) % 2 == 1
+    }
+
     /// Generalised winding number (Jacobson et al. 2013): 1 inside a closed outward mesh, 0
     /// outside, a smooth value in between near holes.
     pub fn winding_number(&self, p: V) -> f64 {

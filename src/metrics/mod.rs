@@ -149,7 +149,7 @@ impl Prepared {
     }
 
     fn finish(shape: Shape, soup: Vec<[V; 3]>, verts: Vec<V>) -> Prepared {
-        let area = soup.iter().map(tri_area).sum();
+        let area = soup.iter().fold(0.0, |s, t| s + tri_area(t));
         let mut bb = Bb::EMPTY;
         for p in &verts {
             bb.grow(*p);
@@ -183,19 +183,65 @@ impl Prepared {
         }
     }
 
-    /// Distance from `p` to the surface when `p` is inside, else 0.
-    fn depth_v(&self, p: V) -> f64 {
+    /// Distance from `p` to the surface when `p` is inside, else 0; with the nearest surface
+    /// triangle when known (a hint for the next, nearby point).
+    fn depth_v(&self, p: V, hint: Option<usize>) -> (f64, Option<usize>) {
         if !self.contains_v(p) {
-            return 0.0;
+            return (0.0, hint);
         }
         match &self.shape {
-            Shape::Mesh(_) => self.surface.point_dist2(p).sqrt(),
-            Shape::Hulls(hs) => hs
-                .iter()
-                .filter(|h| h.contains(p))
-                .map(|h| h.depth(p))
-                .fold(0.0, f64::max),
+            Shape::Mesh(_) => {
+                let (d2, t) = self.surface.nearest(p, hint);
+                (d2.sqrt(), Some(t))
+            }
+            Shape::Hulls(hs) => (
+                hs.iter()
+                    .filter(|h| h.contains(p))
+                    .map(|h| h.depth(p))
+                    .fold(0.0, f64::max),
+                None,
+            ),
         }
+    }
+
+    /// Largest depth inside `self` over the points. A sparse first pass (every 64th point)
+    /// gives a global lower bound; then, in parallel chunks, a point is skipped when an upper
+    /// bound on its depth cannot beat the best so far: the depth of the previous point plus
+    /// their distance (the distance to a surface is 1-Lipschitz), or its distance to the
+    /// previous point's nearest triangle. The maximum is exact and independent of the chunking.
+    fn max_depth_of(&self, points: &[V]) -> f64 {
+        let seed = points
+            .par_iter()
+            .step_by(64)
+            .map(|&p| self.depth_v(p, None).0)
+            .reduce(|| 0.0, f64::max);
+        points
+            .par_chunks(256)
+            .map(|chunk| {
+                let mut best = seed;
+                let mut last: Option<(V, f64)> = None;
+                let mut hint: Option<usize> = None;
+                for &p in chunk {
+                    if let Some((q, dq)) = last {
+                        if dq + geom::norm2(geom::sub(p, q)).sqrt() <= best {
+                            continue;
+                        }
+                    }
+                    if let Some(h) = hint {
+                        if geom::point_tri_dist2(p, &self.surface.tris[h]).sqrt() <= best {
+                            continue;
+                        }
+                    }
+                    let (d, h) = self.depth_v(p, hint);
+                    hint = h;
+                    if d > 0.0 {
+                        last = Some((p, d));
+                        best = best.max(d);
+                    }
+                }
+                best
+            })
+            .reduce(|| seed, f64::max)
     }
 
     /// Points of the surface for depth queries: every vertex inside `within`, plus a
@@ -578,8 +624,7 @@ pub fn r_surface(a: &Prepared, b: &Prepared) -> f64 {
         h.iter()
             .zip(tris)
             .filter(|(&x, _)| x)
-            .map(|(_, t)| tri_area(t))
-            .sum()
+            .fold(0.0, |s, (_, t)| s + tri_area(t))
     };
     (sum(&ha, &a.surface.tris) + sum(&hb, &b.surface.tris)) / total
 }
@@ -593,11 +638,23 @@ fn some_vertex_inside(a: &Prepared, b: &Prepared) -> bool {
 /// Minimum clearance (metres): 0 when the objects overlap or touch, else the exact distance
 /// between their surfaces.
 pub fn min_clearance(a: &Prepared, b: &Prepared) -> f64 {
-    let d2 = a.surface.min_dist2(&b.surface);
-    if d2 == 0.0 || !d2.is_finite() || some_vertex_inside(a, b) {
-        return if d2.is_finite() { 0.0 } else { f64::INFINITY };
+    if a.surface.is_empty() || b.surface.is_empty() {
+        return f64::INFINITY;
     }
-    d2.sqrt()
+    if surfaces_intersect(a, b) || some_vertex_inside(a, b) {
+        return 0.0;
+    }
+    a.surface.min_dist2(&b.surface).sqrt()
+}
+
+/// Whether any triangle of one touches a triangle of the other (stops at the first).
+fn surfaces_intersect(a: &Prepared, b: &Prepared) -> bool {
+    let mut hit = false;
+    a.surface.overlapping_pairs(&b.surface, |i, j| {
+        hit = geom::tri_tri_intersect(&a.surface.tris[i], &b.surface.tris[j]);
+        !hit
+    });
+    hit
 }
 
 /// Maximum penetration depth (metres, >= 0; 0 when not overlapping). See the module
@@ -620,12 +677,8 @@ pub fn max_penetration_depth(a: &Prepared, b: &Prepared, opts: &MetricsOptions) 
     let spacing = opts
         .depth_spacing
         .unwrap_or_else(|| diag(a).min(diag(b)) / 64.0);
-    let into = |src: &Prepared, dst: &Prepared| -> f64 {
-        src.surface_samples(&dst.bb, spacing)
-            .par_iter()
-            .map(|&p| dst.depth_v(p))
-            .reduce(|| 0.0, f64::max)
-    };
+    let into =
+        |src: &Prepared, dst: &Prepared| dst.max_depth_of(&src.surface_samples(&dst.bb, spacing));
     into(a, b).max(into(b, a))
 }
 

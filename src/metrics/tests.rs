@@ -251,17 +251,50 @@ fn open_sphere_volume_close_to_closed() {
 
 #[test]
 fn sphere_with_missing_cap_still_has_its_volume() {
-    // Remove the whole top cap (the first 4 stacks): every z line through it crosses once.
-    let s = uv_sphere(0.05, 32, 64);
-    let cap = 64 + 3 * 2 * 64;
-    let open = Mesh::new(s.vertices.clone(), s.triangles[cap..].to_vec());
+    // Remove the whole bottom cap (4 of 32 stacks, 22.5° around the pole), as in a scan of an
+    // object standing on a table: every z line through the opening crosses the mesh once, so
+    // z parity alone inverts those columns.
+    let (r, stacks, slices) = (0.05, 32, 64);
+    let s = uv_sphere(r, stacks, slices);
+    let cap = slices + 3 * 2 * slices;
+    let open = Mesh::new(
+        s.vertices.clone(),
+        s.triangles[..s.triangles.len() - cap].to_vec(),
+    );
     let pc = prep(&s);
     let po = prep(&open);
     let pb = prep(&moved(&s, 0.04, 0.0, 0.0));
     let o = opts(200_000);
     let (rc, ro) = (r_volume(&pc, &pb, &o), r_volume(&po, &pb, &o));
-    let diff = (rc.inside_a as f64 - ro.inside_a as f64).abs() / rc.inside_a as f64;
-    assert!(diff < 5e-3, "inside count differs by {diff}");
+    // What the open mesh loses is exactly the cap above the opening (outside by the vote: its
+    // x and y lines meet nothing); a spherical cap of height r (1 - cos 22.5°).
+    let h = r * (1.0 - (PI / 8.0).cos());
+    let cap_fraction = PI * h * h * (3.0 * r - h) / 3.0 / (4.0 / 3.0 * PI * r.powi(3));
+    let lost = (rc.inside_a as f64 - ro.inside_a as f64) / rc.inside_a as f64;
+    assert!(
+        lost >= 0.0 && lost < cap_fraction * 1.2,
+        "lost {lost}, cap {cap_fraction}"
+    );
+    // Points well inside, above the opening: the vote classifies all of them right, while
+    // z parity alone gets every one under the opening wrong.
+    let Shape::Mesh(rm) = &po.shape else {
+        unreachable!()
+    };
+    let (mut voted_wrong, mut parity_wrong, mut n) = (0, 0, 0);
+    let mut rng = Rng(3);
+    while n < 2000 {
+        let p = [0.0, 1.0, 2.0].map(|_| (rng.next_f64() * 2.0 - 1.0) * 0.8 * r);
+        if geom::norm2(p) > (0.8 * r).powi(2) {
+            continue;
+        }
+        n += 1;
+        voted_wrong += usize::from(!rm.contains(p));
+        parity_wrong += usize::from(!rm.parity_only(p, 2));
+    }
+    assert_eq!(voted_wrong, 0);
+    // The opening has radius r sin 22.5° = 0.38 r: about 0.38² / 0.8² of the inner ball's
+    // z columns pass through it.
+    assert!(parity_wrong > n / 10, "{parity_wrong}");
 }
 
 #[test]
