@@ -236,15 +236,26 @@ impl RayMesh {
         }
     }
 
-    /// Inside-ness of a single point (line along z first).
+    /// Inside-ness of a single point: all six half-lines along ±x, ±y, ±z vote (a 3:3 tie goes
+    /// to the generalised winding number). Stricter than the per-column rule of R_volume, which
+    /// trusts a line with an even crossing count: a line through two holes (e.g. both poles of
+    /// a scan) is even but wrong, and for a single query three rays are cheap.
     pub fn contains(&self, p: V) -> bool {
         if !self.bb.contains(p) {
             return false;
         }
         let mut line = Vec::new();
-        let mut scratch = Vec::new();
-        self.crossings(2, p, &mut line);
-        self.classify(p, 2, &line, &mut scratch)
+        let mut votes = 0;
+        for axis in 0..3 {
+            self.crossings(axis, p, &mut line);
+            let below = line.partition_point(|&t| t < p[axis]);
+            votes += below % 2 + (line.len() - below) % 2;
+        }
+        match votes {
+            v if v > 3 => true,
+            v if v < 3 => false,
+            _ => self.winding_number(p).abs() > 0.5,
+        }
     }
 
     /// Parity of the crossings below `p` along one axis, without any vote (tests only: what
