@@ -14,6 +14,7 @@ pub mod fsutil;
 pub mod inertia;
 pub mod io;
 pub mod mesh;
+pub mod metrics;
 pub mod physics;
 pub mod pipeline;
 pub mod pose;
