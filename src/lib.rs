@@ -22,5 +22,6 @@ pub mod prepare;
 pub mod report;
 pub mod scene;
 pub mod shapes;
+pub mod validate;
 
 pub use error::{Error, Result};

@@ -23,6 +23,67 @@ struct Cli {
 enum Command {
     /// Export a scene (Interact3D sample folder or scene.json) to MJCF + URDF assets.
     Export(ExportArgs),
+    /// Check a scene or an export folder: interpenetration metrics and a Rapier settle test.
+    Validate(ValidateArgs),
+}
+
+#[derive(Args, Clone)]
+struct CheckArgs {
+    /// Sample points for R_volume.
+    #[arg(long, default_value_t = 1_000_000)]
+    points: usize,
+    /// Largest penetration between collision hulls of different objects at the composed pose (m).
+    #[arg(long, default_value_t = 1e-4)]
+    max_penetration: f64,
+    /// Largest drift while settling, as a fraction of the object's bounding-box diagonal.
+    #[arg(long, default_value_t = 0.1)]
+    max_drift: f64,
+    /// Largest rotation while settling (degrees).
+    #[arg(long, default_value_t = 30.0)]
+    max_settle_rotation: f64,
+    /// Largest motion during the rest check (m).
+    #[arg(long, default_value_t = 1e-3)]
+    max_rest_motion: f64,
+    /// Largest rotation during the rest check (degrees).
+    #[arg(long, default_value_t = 1.0)]
+    max_rest_rotation: f64,
+    /// Largest contact penetration during the rest check (m).
+    #[arg(long, default_value_t = 1e-3)]
+    max_rest_penetration: f64,
+    /// Skip the metrics on the visual meshes (collision hulls are always checked).
+    #[arg(long)]
+    no_visual_metrics: bool,
+}
+
+impl CheckArgs {
+    fn options(&self) -> interact3d::validate::ValidateOptions {
+        let mut o = interact3d::validate::ValidateOptions::default();
+        o.metrics.points = self.points;
+        o.max_collision_penetration = self.max_penetration;
+        o.settle.max_relative_drift = self.max_drift;
+        o.settle.max_settle_rotation_deg = self.max_settle_rotation;
+        o.settle.max_rest_motion = self.max_rest_motion;
+        o.settle.max_rest_rotation_deg = self.max_rest_rotation;
+        o.settle.max_rest_penetration = self.max_rest_penetration;
+        o.visual_metrics = !self.no_visual_metrics;
+        o
+    }
+}
+
+#[derive(Args)]
+struct ValidateArgs {
+    /// A scene (sample folder, scene.json, mesh file) or an export output folder.
+    path: PathBuf,
+    #[command(flatten)]
+    build: BuildArgs,
+    #[command(flatten)]
+    check: CheckArgs,
+    /// Print the whole validation report as JSON on stdout.
+    #[arg(long)]
+    json: bool,
+    /// Write JUnit XML (one test case per check) to this file.
+    #[arg(long, value_name = "FILE")]
+    junit: Option<PathBuf>,
 }
 
 #[derive(Args)]
@@ -59,6 +120,17 @@ struct ExportArgs {
     /// Replace OUT even if it is not an earlier interact3d export.
     #[arg(long)]
     force: bool,
+    /// Do not validate (no metrics, no settle; bodies start at the composed pose).
+    #[arg(long)]
+    no_validate: bool,
+    /// Start bodies at the composed pose even when validation passes (default: settled pose).
+    #[arg(long)]
+    keep_composed_pose: bool,
+    #[command(flatten)]
+    check: CheckArgs,
+    /// Write JUnit XML of the validation to this file.
+    #[arg(long, value_name = "FILE")]
+    junit: Option<PathBuf>,
 }
 
 fn parse_size(s: &str) -> Result<(String, f64), String> {
@@ -88,10 +160,7 @@ fn main() -> ExitCode {
         Ok(code) => code,
         Err(e) => {
             eprintln!("error: {e}");
-            ExitCode::from(match e {
-                Error::Internal(_) => 2,
-                _ => 2,
-            })
+            ExitCode::from(2)
         }
     }
 }
@@ -105,10 +174,13 @@ fn run(cli: Cli) -> Result<ExitCode, Error> {
                     templates: a.templates,
                     force: a.force,
                 },
+                validate: (!a.no_validate).then(|| a.check.options()),
+                keep_composed_pose: a.keep_composed_pose,
                 ..Default::default()
             };
             let t = std::time::Instant::now();
-            let report = interact3d::pipeline::export_scene(&a.scene, &a.out, &job)?;
+            let done = interact3d::pipeline::export_scene(&a.scene, &a.out, &job)?;
+            let report = &done.report;
             for o in &report.objects {
                 eprintln!(
                     "{:<16} mass {:>9.4} kg  hulls {:>3}  max verts {:>3}  {}",
@@ -129,7 +201,54 @@ fn run(cli: Cli) -> Result<ExitCode, Error> {
                 a.out.display(),
                 t.elapsed().as_secs_f64()
             );
-            Ok(ExitCode::SUCCESS)
+            match &done.validation {
+                Some(v) => {
+                    eprint!("{}", interact3d::validate::table(v));
+                    if let Some(f) = &a.junit {
+                        interact3d::fsutil::write_atomically(
+                            f,
+                            interact3d::validate::junit(&report.scene, v).as_bytes(),
+                        )?;
+                    }
+                    Ok(if v.passed {
+                        ExitCode::SUCCESS
+                    } else {
+                        ExitCode::from(1)
+                    })
+                }
+                None => Ok(ExitCode::SUCCESS),
+            }
+        }
+        Command::Validate(a) => {
+            let t = std::time::Instant::now();
+            let (assembly, v) = interact3d::pipeline::validate_path(
+                &a.path,
+                &Default::default(),
+                &a.build.options(),
+                &a.check.options(),
+            )?;
+            eprint!("{}", interact3d::validate::table(&v));
+            eprintln!(
+                "validated {} in {:.2} s",
+                assembly.name,
+                t.elapsed().as_secs_f64()
+            );
+            if a.json {
+                let json =
+                    serde_json::to_string_pretty(&v).map_err(|e| Error::Internal(e.to_string()))?;
+                println!("{json}");
+            }
+            if let Some(f) = &a.junit {
+                interact3d::fsutil::write_atomically(
+                    f,
+                    interact3d::validate::junit(&assembly.name, &v).as_bytes(),
+                )?;
+            }
+            Ok(if v.passed {
+                ExitCode::SUCCESS
+            } else {
+                ExitCode::from(1)
+            })
         }
     }
 }

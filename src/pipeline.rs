@@ -6,6 +6,7 @@ use crate::error::Result;
 use crate::export::{export, ExportOptions};
 use crate::io::Limits;
 use crate::report::Report;
+use crate::validate::{apply_settled_poses, validate, ValidateOptions, Validation};
 use std::path::Path;
 
 /// Everything `export` needs.
@@ -14,6 +15,11 @@ pub struct ExportJob {
     pub limits: Limits,
     pub build: BuildOptions,
     pub export: ExportOptions,
+    /// Validate before writing (`None`: skip, `--no-validate`).
+    pub validate: Option<ValidateOptions>,
+    /// Keep the composed poses as the bodies' initial poses even when validation passes
+    /// (by default a passing scene starts from its settled poses).
+    pub keep_composed_pose: bool,
 }
 
 /// Load a scene (sample folder or manifest) and build its bodies.
@@ -22,10 +28,45 @@ pub fn load_assembly(scene: &Path, limits: &Limits, opts: &BuildOptions) -> Resu
     build(&scene, opts)
 }
 
-/// Export a scene to `out`; returns the report written.
-pub fn export_scene(scene: &Path, out: &Path, job: &ExportJob) -> Result<Report> {
-    let assembly = load_assembly(scene, &job.limits, &job.build)?;
-    let report = Report::new(&assembly);
+/// The result of an export.
+pub struct Exported {
+    pub report: Report,
+    pub validation: Option<Validation>,
+}
+
+/// Export a scene to `out`, validating it first unless told not to; returns what was written.
+/// A scene that fails validation is still exported (its report says why), from its composed poses.
+pub fn export_scene(scene: &Path, out: &Path, job: &ExportJob) -> Result<Exported> {
+    let mut assembly = load_assembly(scene, &job.limits, &job.build)?;
+    let mut report = Report::new(&assembly);
+    let validation = match &job.validate {
+        Some(opts) => {
+            let v = validate(&assembly, opts)?;
+            if v.passed && !job.keep_composed_pose {
+                apply_settled_poses(&mut assembly, &v);
+            }
+            report.validation =
+                Some(serde_json::to_value(&v).map_err(|e| crate::Error::Internal(e.to_string()))?);
+            Some(v)
+        }
+        None => None,
+    };
     export(&assembly, &report, out, &job.export)?;
-    Ok(report)
+    Ok(Exported { report, validation })
+}
+
+/// Validate a scene, or an export folder (its hulls and inertials as written, from its initial poses).
+pub fn validate_path(
+    path: &Path,
+    limits: &Limits,
+    build: &BuildOptions,
+    opts: &ValidateOptions,
+) -> Result<(Assembly, Validation)> {
+    let assembly = if crate::export::read::is_export(path) {
+        crate::export::read::load(path, limits)?
+    } else {
+        load_assembly(path, limits, build)?
+    };
+    let v = validate(&assembly, opts)?;
+    Ok((assembly, v))
 }

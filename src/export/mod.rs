@@ -13,6 +13,7 @@
 
 mod files;
 pub mod format;
+pub mod read;
 mod templates;
 
 pub use templates::Templates;

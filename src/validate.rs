@@ -1,0 +1,315 @@
+//! Validation: is the scene free of interpenetration, and does it stay put when simulated?
+//!
+//! 1. **Static**, at the composed pose: for every pair of objects the Interact3D metrics
+//!    (R_volume, R_surface, max penetration depth, min clearance) on the visual meshes and on the
+//!    collision hulls. Gate: collision hulls of different objects penetrate by at most
+//!    `max_collision_penetration` (0.1 mm). Visual interpenetration is reported, and warned about.
+//! 2. **Dynamic**, in Rapier ([`crate::physics`]): settle from the composed pose (drift, turn, left
+//!    its support), then rest 1 s (motion, turn, contact penetration).
+//!
+//! Every check is a [`Check`] with its value and limit, so a report, a table and JUnit XML all
+//! come from the same list.
+
+use crate::body::Assembly;
+use crate::error::{Error, Result};
+use crate::metrics::{scene_metrics, MetricsOptions, PairMetrics, Solid};
+use crate::physics::{settle, SettleOptions, SettleReport, SimBody};
+use serde::Serialize;
+
+/// Thresholds and settings of the validation.
+#[derive(Clone, Debug, Serialize)]
+pub struct ValidateOptions {
+    pub metrics: MetricsOptions,
+    pub settle: SettleOptions,
+    /// Largest penetration between collision hulls of different objects at the composed pose (m).
+    pub max_collision_penetration: f64,
+    /// Also compute the metrics on the visual meshes (the paper's numbers).
+    pub visual_metrics: bool,
+}
+
+impl Default for ValidateOptions {
+    fn default() -> Self {
+        ValidateOptions {
+            metrics: MetricsOptions::default(),
+            settle: SettleOptions::default(),
+            max_collision_penetration: 1e-4,
+            visual_metrics: true,
+        }
+    }
+}
+
+/// The metrics of one pair of objects.
+#[derive(Clone, Debug, Serialize)]
+pub struct PairReport {
+    pub a: String,
+    pub b: String,
+    /// On the visual meshes (absent with `visual_metrics` off).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub visual: Option<PairMetrics>,
+    /// On the collision hulls (what the simulator sees).
+    pub collision: PairMetrics,
+}
+
+/// One pass/fail check.
+#[derive(Clone, Debug, Serialize, PartialEq)]
+pub struct Check {
+    /// `static_penetration`, `settle`, `rest`.
+    pub name: String,
+    /// The object (or `a/b` pair) it is about.
+    pub subject: String,
+    pub passed: bool,
+    /// The measured value and its limit, in the check's unit (m, or deg, or a ratio).
+    pub value: f64,
+    pub limit: f64,
+    pub message: String,
+}
+
+/// The validation of one scene.
+#[derive(Clone, Debug, Serialize)]
+pub struct Validation {
+    pub passed: bool,
+    pub checks: Vec<Check>,
+    pub pairs: Vec<PairReport>,
+    pub settle: SettleReport,
+    pub options: ValidateOptions,
+    pub warnings: Vec<String>,
+}
+
+/// The bodies as the physics module takes them (at the composed pose).
+pub fn sim_bodies(a: &Assembly) -> Vec<SimBody> {
+    a.bodies
+        .iter()
+        .map(|b| SimBody {
+            name: b.name.clone(),
+            pose: b.composed_pose,
+            hulls: b.hulls.iter().map(|h| h.mesh()).collect(),
+            mass: b.inertial.mass,
+            com: b.inertial.com,
+            inertia: b.inertial.inertia,
+            friction: b.friction,
+            fixed: b.fixed,
+        })
+        .collect()
+}
+
+/// Run every check on an assembly.
+pub fn validate(a: &Assembly, opts: &ValidateOptions) -> Result<Validation> {
+    let mut warnings = Vec::new();
+    // Static metrics, world frame at the composed pose.
+    let world_hulls: Vec<Vec<crate::mesh::Mesh>> = a
+        .bodies
+        .iter()
+        .map(|b| b.world_hulls().iter().map(|h| h.mesh()).collect())
+        .collect();
+    let collision = scene_metrics(
+        &world_hulls
+            .iter()
+            .map(|h| Solid::Hulls(h))
+            .collect::<Vec<_>>(),
+        &opts.metrics,
+    );
+    let visual = if opts.visual_metrics {
+        let world: Vec<crate::mesh::Mesh> = a.bodies.iter().map(|b| b.world_geometry()).collect();
+        Some(scene_metrics(
+            &world.iter().map(Solid::Mesh).collect::<Vec<_>>(),
+            &opts.metrics,
+        ))
+    } else {
+        None
+    };
+    let mut checks = Vec::new();
+    let mut pairs = Vec::new();
+    for (k, c) in collision.iter().enumerate() {
+        let (na, nb) = (&a.bodies[c.a].name, &a.bodies[c.b].name);
+        let v = visual.as_ref().map(|v| v[k].metrics.clone());
+        if let Some(v) = &v {
+            if v.max_penetration_depth > 0.0 {
+                warnings.push(format!(
+                    "visual meshes of {na} and {nb} interpenetrate by {:.3} mm (R_volume {:.2e})",
+                    v.max_penetration_depth * 1e3,
+                    v.r_volume
+                ));
+            }
+        }
+        let depth = c.metrics.max_penetration_depth;
+        checks.push(Check {
+            name: "static_penetration".into(),
+            subject: format!("{na}/{nb}"),
+            passed: depth <= opts.max_collision_penetration,
+            value: depth,
+            limit: opts.max_collision_penetration,
+            message: format!(
+                "collision hulls penetrate by {:.3} mm at the composed pose (limit {:.3} mm)",
+                depth * 1e3,
+                opts.max_collision_penetration * 1e3
+            ),
+        });
+        pairs.push(PairReport {
+            a: na.clone(),
+            b: nb.clone(),
+            visual: v,
+            collision: c.metrics.clone(),
+        });
+    }
+    // Dynamics.
+    let settle = settle(&sim_bodies(a), &opts.settle).map_err(|e| Error::Input {
+        path: a.name.clone().into(),
+        message: format!("cannot simulate: {e}"),
+    })?;
+    let s = &opts.settle;
+    for b in &settle.bodies {
+        if b.fixed {
+            continue;
+        }
+        let settle_ok = b.relative_drift <= s.max_relative_drift
+            && b.settle_rotation_deg <= s.max_settle_rotation_deg
+            && !b.left_supports
+            && !b.ended_on_floor;
+        let settle_reasons: Vec<&String> = b
+            .reasons
+            .iter()
+            .filter(|r| !r.contains("rest check"))
+            .collect();
+        checks.push(Check {
+            name: "settle".into(),
+            subject: b.name.clone(),
+            passed: settle_ok && b.initial_penetration <= s.max_initial_penetration,
+            value: b.settle_displacement,
+            limit: s.max_relative_drift * b.bbox_diagonal,
+            message: if settle_reasons.is_empty() {
+                format!(
+                    "moved {:.3} mm, turned {:.2}° while settling",
+                    b.settle_displacement * 1e3,
+                    b.settle_rotation_deg
+                )
+            } else {
+                settle_reasons
+                    .iter()
+                    .map(|r| r.as_str())
+                    .collect::<Vec<_>>()
+                    .join("; ")
+            },
+        });
+        let rest_ok = b.rest_displacement <= s.max_rest_motion
+            && b.rest_rotation_deg <= s.max_rest_rotation_deg
+            && b.rest_max_penetration <= s.max_rest_penetration;
+        checks.push(Check {
+            name: "rest".into(),
+            subject: b.name.clone(),
+            passed: rest_ok,
+            value: b.rest_displacement,
+            limit: s.max_rest_motion,
+            message: match b
+                .reasons
+                .iter()
+                .filter(|r| r.contains("rest check"))
+                .cloned()
+                .collect::<Vec<_>>()
+            {
+                r if !r.is_empty() => r.join("; "),
+                _ => format!(
+                    "at rest: moved {:.3} mm, turned {:.3}°, contact penetration {:.3} mm",
+                    b.rest_displacement * 1e3,
+                    b.rest_rotation_deg,
+                    b.rest_max_penetration * 1e3
+                ),
+            },
+        });
+    }
+    warnings.extend(settle.warnings.iter().cloned());
+    let passed = checks.iter().all(|c| c.passed) && settle.passed;
+    Ok(Validation {
+        passed,
+        checks,
+        pairs,
+        settle,
+        options: opts.clone(),
+        warnings,
+    })
+}
+
+/// Move every body to its settled pose (the composed pose is kept in `composed_pose`).
+pub fn apply_settled_poses(a: &mut Assembly, v: &Validation) {
+    for b in &mut a.bodies {
+        if let Some(r) = v.settle.bodies.iter().find(|r| r.name == b.name) {
+            if !b.fixed {
+                b.pose = r.settled_pose.isometry();
+            }
+        }
+    }
+}
+
+/// A compact table for people: object, moved, turned, penetration, verdict.
+pub fn table(v: &Validation) -> String {
+    let mut s = format!(
+        "{:<20} {:>10} {:>10} {:>12}  verdict\n",
+        "object", "moved mm", "turned °", "penetr. mm"
+    );
+    for b in &v.settle.bodies {
+        let pen = v
+            .pairs
+            .iter()
+            .filter(|p| p.a == b.name || p.b == b.name)
+            .map(|p| p.collision.max_penetration_depth)
+            .fold(b.rest_max_penetration, f64::max);
+        let ok = v
+            .checks
+            .iter()
+            .filter(|c| c.subject == b.name || c.subject.split('/').any(|x| x == b.name))
+            .all(|c| c.passed);
+        s += &format!(
+            "{:<20} {:>10.3} {:>10.2} {:>12.3}  {}\n",
+            b.name,
+            (b.settle_displacement + b.rest_displacement) * 1e3,
+            b.settle_rotation_deg + b.rest_rotation_deg,
+            pen * 1e3,
+            if b.fixed {
+                "fixed"
+            } else if ok {
+                "pass"
+            } else {
+                "FAIL"
+            }
+        );
+    }
+    for c in v.checks.iter().filter(|c| !c.passed) {
+        s += &format!("  FAIL {} {}: {}\n", c.name, c.subject, c.message);
+    }
+    s += &format!("verdict: {}\n", if v.passed { "PASS" } else { "FAIL" });
+    s
+}
+
+/// JUnit XML, one test case per check (for CI systems).
+pub fn junit(scene: &str, v: &Validation) -> String {
+    let esc = |s: &str| {
+        s.replace('&', "&amp;")
+            .replace('<', "&lt;")
+            .replace('>', "&gt;")
+            .replace('"', "&quot;")
+    };
+    let failures = v.checks.iter().filter(|c| !c.passed).count();
+    let mut s = format!(
+        "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n<testsuites>\n  <testsuite name=\"{}\" tests=\"{}\" failures=\"{failures}\">\n",
+        esc(scene),
+        v.checks.len()
+    );
+    for c in &v.checks {
+        s += &format!(
+            "    <testcase classname=\"{}.{}\" name=\"{}\">",
+            esc(scene),
+            esc(&c.name),
+            esc(&c.subject)
+        );
+        if !c.passed {
+            s += &format!(
+                "<failure message=\"{}\">value {} limit {}</failure>",
+                esc(&c.message),
+                c.value,
+                c.limit
+            );
+        }
+        s += "</testcase>\n";
+    }
+    s += "  </testsuite>\n</testsuites>\n";
+    s
+}
