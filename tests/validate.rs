@@ -1,0 +1,251 @@
+//! The validation verdict means something: it agrees with MuJoCo and PyBullet on every fixture,
+//! the must-fail fixtures fail for the right reason, and the outputs (exit code, JSON, JUnit) are
+//! what CI systems expect.
+
+mod common;
+use common::*;
+use std::path::Path;
+
+const MM: f64 = 1e-3;
+
+struct Outcome {
+    code: i32,
+    report: serde_json::Value,
+    out: tempfile::TempDir,
+}
+
+fn export_validated(scene: &Path) -> Outcome {
+    let out = tempfile::tempdir().unwrap();
+    let dir = out.path().join("out");
+    let (code, _, err) = run(&[
+        "export",
+        scene.to_str().unwrap(),
+        "-o",
+        dir.to_str().unwrap(),
+    ]);
+    assert!(code == 0 || code == 1, "export {}: {err}", scene.display());
+    let report = read_json(&dir.join("report.json"));
+    assert_eq!(
+        report["validation"]["passed"].as_bool().unwrap(),
+        code == 0,
+        "exit code follows the verdict"
+    );
+    Outcome { code, report, out }
+}
+
+/// Objects Rapier failed (any failed check naming them).
+fn rapier_failed(report: &serde_json::Value) -> Vec<String> {
+    let mut v: Vec<String> = report["validation"]["checks"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter(|c| !c["passed"].as_bool().unwrap())
+        .flat_map(|c| {
+            c["subject"]
+                .as_str()
+                .unwrap()
+                .split('/')
+                .map(str::to_string)
+                .collect::<Vec<_>>()
+        })
+        .collect();
+    v.sort();
+    v.dedup();
+    v
+}
+
+/// Objects an engine flags: moved > 1 mm or turned > 1° in 1 s.
+fn engine_flagged(result: &serde_json::Value) -> Vec<String> {
+    let mut v: Vec<String> = result["motion"]
+        .as_object()
+        .unwrap()
+        .iter()
+        .filter(|(_, m)| {
+            m["moved_m"].as_f64().unwrap() > MM || m["turned_deg"].as_f64().unwrap() > 1.0
+        })
+        .map(|(k, _)| k.clone())
+        .collect();
+    v.sort();
+    v
+}
+
+#[test]
+fn mujoco_and_pybullet_agree_with_the_rapier_verdict_on_every_fixture() {
+    for scene in fixtures() {
+        let o = export_validated(&scene);
+        let dir = o.out.path().join("out");
+        let mj = python_json("check_mujoco.py", &[dir.to_str().unwrap()]);
+        let pb = python_json("check_pybullet.py", &[dir.to_str().unwrap()]);
+        let name = scene.file_name().unwrap().to_string_lossy().to_string();
+        let failed = rapier_failed(&o.report);
+        if o.code == 0 {
+            // Pass: from the exported (settled) poses nothing moves and nothing overlaps.
+            assert!(
+                engine_flagged(&mj).is_empty(),
+                "{name}: Rapier passed but MuJoCo moved {:?}: {}",
+                engine_flagged(&mj),
+                mj["motion"]
+            );
+            assert!(
+                mj["initial_penetration"].as_f64().unwrap() <= MM,
+                "{name}: MuJoCo initial penetration {}",
+                mj["initial_penetration"]
+            );
+            assert!(
+                engine_flagged(&pb).is_empty(),
+                "{name}: Rapier passed but PyBullet moved {:?}: {}",
+                engine_flagged(&pb),
+                pb["motion"]
+            );
+        } else {
+            // Fail: every object Rapier flags, MuJoCo flags too (moves, or starts overlapping).
+            let mut mj_flags = engine_flagged(&mj);
+            if mj["initial_penetration"].as_f64().unwrap() > MM {
+                mj_flags.extend(
+                    mj["initial_penetration_pair"]
+                        .as_array()
+                        .unwrap()
+                        .iter()
+                        .map(|x| x.as_str().unwrap().to_string()),
+                );
+            }
+            let pb_flags = engine_flagged(&pb);
+            let some_flag = failed.iter().any(|f| mj_flags.contains(f));
+            assert!(
+                some_flag,
+                "{name}: Rapier failed {failed:?}, MuJoCo flagged {mj_flags:?}"
+            );
+            let moved_in_rapier: Vec<&String> = failed
+                .iter()
+                .filter(|f| {
+                    o.report["validation"]["checks"]
+                        .as_array()
+                        .unwrap()
+                        .iter()
+                        .any(|c| {
+                            c["subject"] == f.as_str()
+                                && c["name"] == "settle"
+                                && !c["passed"].as_bool().unwrap()
+                                && c["message"].as_str().unwrap().contains("drifted")
+                        })
+                })
+                .collect();
+            for f in moved_in_rapier {
+                assert!(
+                    mj_flags.contains(f),
+                    "{name}: Rapier saw {f} drift, MuJoCo did not: {}",
+                    mj["motion"]
+                );
+                assert!(
+                    pb_flags.contains(f),
+                    "{name}: Rapier saw {f} drift, PyBullet did not: {}",
+                    pb["motion"]
+                );
+            }
+        }
+    }
+}
+
+#[test]
+fn interpenetrating_fixture_fails_on_the_measured_depth() {
+    let o = export_validated(&root().join("fixtures/fail_interpenetrating"));
+    assert_eq!(o.code, 1);
+    let c = o.report["validation"]["checks"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|c| c["name"] == "static_penetration")
+        .unwrap()
+        .clone();
+    assert_eq!(c["passed"], false);
+    // The top box is sunk 3 mm into the base (fixtures/fail_interpenetrating/README.md).
+    assert!((c["value"].as_f64().unwrap() - 0.003).abs() < 1e-6, "{c}");
+    let pair = &o.report["validation"]["pairs"][0];
+    assert!(
+        (pair["visual"]["max_penetration_depth"].as_f64().unwrap() - 0.003).abs() < 1e-4,
+        "{pair}"
+    );
+    assert!(pair["visual"]["r_volume"].as_f64().unwrap() > 0.0);
+    // Bodies start where they were composed when the scene fails.
+    let scene = read_json(&o.out.path().join("out/scene.json"));
+    assert!(scene["objects"][0].get("composed_pose").is_none());
+}
+
+#[test]
+fn unstable_fixture_fails_by_toppling() {
+    let o = export_validated(&root().join("fixtures/fail_unstable"));
+    assert_eq!(o.code, 1);
+    let b = &o.report["validation"]["settle"]["bodies"][0];
+    assert!(b["settle_rotation_deg"].as_f64().unwrap() > 30.0, "{b}");
+    assert_eq!(b["passed"], false);
+}
+
+#[test]
+fn validate_command_json_junit_and_exit_codes() {
+    let t = tempfile::tempdir().unwrap();
+    let junit = t.path().join("junit.xml");
+    let scene = root().join("fixtures/fail_interpenetrating");
+    let (code, stdout, stderr) = run(&[
+        "validate",
+        scene.to_str().unwrap(),
+        "--json",
+        "--junit",
+        junit.to_str().unwrap(),
+        "--points",
+        "100000",
+    ]);
+    assert_eq!(code, 1, "{stderr}");
+    assert!(stderr.contains("verdict: FAIL"));
+    let v: serde_json::Value = serde_json::from_str(&stdout).expect("JSON on stdout");
+    assert_eq!(v["passed"], false);
+    let p = &v["pairs"][0]["collision"];
+    for k in [
+        "r_volume",
+        "r_surface",
+        "max_penetration_depth",
+        "min_clearance",
+    ] {
+        assert!(p[k].is_number(), "{k} in {p}");
+    }
+    let xml = std::fs::read_to_string(&junit).unwrap();
+    assert!(
+        xml.contains("<testsuite") && xml.contains("<failure"),
+        "{xml}"
+    );
+    let cases = xml.matches("<testcase").count();
+    assert_eq!(cases, v["checks"].as_array().unwrap().len());
+    // Unreadable input: exit 2.
+    let (code, _, err) = run(&["validate", t.path().join("nothing").to_str().unwrap()]);
+    assert_eq!(code, 2, "{err}");
+}
+
+#[test]
+fn export_folder_validates_from_its_settled_poses() {
+    let o = export_validated(&root().join("fixtures/ball_bowl"));
+    if o.code != 0 {
+        panic!("ball_bowl must pass: {}", o.report["validation"]["checks"]);
+    }
+    let dir = o.out.path().join("out");
+    let scene = read_json(&dir.join("scene.json"));
+    assert!(
+        scene["objects"][1].get("composed_pose").is_some(),
+        "composed pose kept"
+    );
+    let xml = std::fs::read_to_string(dir.join("scene.xml")).unwrap();
+    assert!(xml.contains(r#"<key name="composed""#) && xml.contains(r#"<key name="settled""#));
+    let (code, stdout, err) = run(&[
+        "validate",
+        dir.to_str().unwrap(),
+        "--json",
+        "--points",
+        "100000",
+    ]);
+    assert_eq!(code, 0, "{err}");
+    let v: serde_json::Value = serde_json::from_str(&stdout).unwrap();
+    for b in v["settle"]["bodies"].as_array().unwrap() {
+        assert!(
+            b["settle_displacement"].as_f64().unwrap() < 0.5 * MM,
+            "already at rest: {b}"
+        );
+    }
+}
