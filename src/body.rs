@@ -3,8 +3,8 @@
 
 use crate::decompose::{vhacd::Vhacd, DecomposeOptions, Decomposer, Hull};
 use crate::error::{Error, Result};
-use crate::inertia::{self, Inertial, VolumeSource, DEFAULT_DENSITY};
-use crate::mesh::{Mesh, VisualMesh, V3};
+use crate::inertia::{self, Inertial, DEFAULT_DENSITY};
+use crate::mesh::{Mesh, VisualMesh};
 use crate::pose::Similarity;
 use crate::prepare::{prepare, PrepareOptions, PreparedScene};
 use crate::scene::Scene;
@@ -161,9 +161,6 @@ pub fn assemble(
             translation: o.to_world.translation - com.coords,
             ..o.to_world
         };
-        if inertial.source == VolumeSource::HullUnion && !o.closed {
-            // already explained in the prepare warning
-        }
         bodies.push(Body {
             name: o.name.clone(),
             label: o.label.clone(),
@@ -180,7 +177,6 @@ pub fn assemble(
             warnings,
         });
     }
-    let _ = V3::zeros();
     Ok(Assembly {
         name: prepared.name.clone(),
         bodies,

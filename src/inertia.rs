@@ -5,7 +5,7 @@
 //! so summing their individual mass properties would count the overlap twice).
 
 use crate::decompose::Hull;
-use crate::mesh::{Aabb, Mesh, P3, V3};
+use crate::mesh::{Mesh, P3, V3};
 use nalgebra::Matrix3;
 use serde::Serialize;
 
@@ -130,13 +130,6 @@ pub fn of_hull_union(hulls: &[Hull], density: f64, resolution: usize) -> Option<
         volume: m0,
         source: VolumeSource::HullUnion,
     })
-}
-
-/// Check whether the box `a` ... helper kept private to the module tests.
-#[allow(dead_code)]
-fn aabb_volume(a: &Aabb) -> f64 {
-    let e = a.extents();
-    e.x * e.y * e.z
 }
 
 #[cfg(test)]

@@ -19,7 +19,7 @@ mod templates;
 pub use templates::Templates;
 
 use crate::body::{Assembly, Body};
-use crate::error::{Error, Result};
+use crate::error::Result;
 use crate::report::Report;
 use crate::scene::manifest::{InertialSpec, Manifest, ManifestObject, PoseSpec, Units};
 use crate::scene::UpAxis;
@@ -292,6 +292,3 @@ fn manifest(a: &Assembly) -> Manifest {
             .collect(),
     }
 }
-
-#[allow(dead_code)]
-fn _assert_error_type(_: Error) {}
