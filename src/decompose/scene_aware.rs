@@ -44,7 +44,7 @@
 
 pub mod geom;
 pub mod metrics;
-mod patches;
+pub mod patches;
 
 use super::{cache, DecomposeOptions, Decomposer, Hull};
 use crate::error::Result;
@@ -322,13 +322,32 @@ fn build_part(
         normal = V3::zeros();
     } else {
         pos.extend(neg);
+        // Vertex normals from this patch's triangles only: at a crease (a floor meeting a
+        // wall) the whole-mesh normal would push the copies sideways, along the patch.
+        let mut vs: Vec<u32> = pos.clone();
+        vs.sort_unstable();
+        vs.dedup();
+        let mut vn = vec![V3::zeros(); vs.len()];
+        for &t in &tris {
+            let w = s.tri_normal[t as usize] * s.tri_area[t as usize];
+            for k in s.mesh.triangles[t as usize] {
+                if let Ok(i) = vs.binary_search(&k) {
+                    vn[i] += w;
+                }
+            }
+        }
         let ray_max = p.d_max / 0.45 * 1.01;
         for v in pick(pos) {
             let q = s.mesh.vertices[v as usize];
-            let mut n = s.vert_normal[v as usize];
-            if n.norm() == 0.0 {
-                n = normal;
-            }
+            let mut n = vs
+                .binary_search(&v)
+                .map(|i| vn[i])
+                .unwrap_or_else(|_| V3::zeros());
+            n = if n.norm() > 0.0 {
+                n.normalize()
+            } else {
+                normal
+            };
             let thick = s.thickness(&q, &n, ray_max);
             let d = (0.45 * thick).min(p.d_max).max(p.d_min);
             outer.push(q);
@@ -410,7 +429,10 @@ fn shortcut(s: &Surface, p: &Params, opts: &DecomposeOptions) -> Option<Part> {
     })
 }
 
-/// Split a part's patch in two; `None` when it cannot be split.
+/// Split a part's patch in two; `None` when it cannot be split. Three candidate splits are
+/// built — 2-means in feature space and area-median cuts across the two main axes of the patch
+/// (PCA of the mid-wall positions) — and the one whose worse half deviates least is kept: a
+/// concave patch is thus cut across its most curved direction, which halves its sagitta fastest.
 fn split(
     s: &Surface,
     f: &patches::Features,
@@ -421,17 +443,75 @@ fn split(
     if part.tris.len() < 2 {
         return None;
     }
+    let mut cands: Vec<(Vec<u32>, Vec<u32>)> = Vec::new();
     let halves = patches::kmeans(s, f, &part.tris, 2, p.lambda, 12);
-    if halves.len() < 2 {
-        return None;
+    if halves.len() == 2 {
+        let mut it = halves.into_iter();
+        cands.push((it.next()?, it.next()?));
     }
-    let mut it = halves.into_iter();
-    let (a, b) = (it.next()?, it.next()?);
-    let (pa, pb) = rayon::join(
-        || build_part(s, p, opts, a, part.cuts.clone()),
-        || build_part(s, p, opts, b, part.cuts.clone()),
-    );
-    Some((pa?, pb?))
+    // PCA of the area-weighted mid-wall positions.
+    let w: f64 = part.tris.iter().map(|&t| s.tri_area[t as usize]).sum();
+    if w > 0.0 {
+        let mean = part.tris.iter().fold(V3::zeros(), |a, &t| {
+            a + f.pos[t as usize].coords * s.tri_area[t as usize]
+        }) / w;
+        let mut cov = nalgebra::Matrix3::zeros();
+        for &t in &part.tris {
+            let d = f.pos[t as usize].coords - mean;
+            cov += d * d.transpose() * s.tri_area[t as usize];
+        }
+        let eig = nalgebra::SymmetricEigen::new(cov);
+        let mut order = [0usize, 1, 2];
+        order.sort_by(|&a, &b| {
+            eig.eigenvalues[b]
+                .total_cmp(&eig.eigenvalues[a])
+                .then(a.cmp(&b))
+        });
+        for &k in &order[..2] {
+            let axis = eig.eigenvectors.column(k).into_owned();
+            let mut by: Vec<(f64, u32)> = part
+                .tris
+                .iter()
+                .map(|&t| (axis.dot(&f.pos[t as usize].coords), t))
+                .collect();
+            by.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+            let mut acc = 0.0;
+            let mut cut = by.len() / 2;
+            for (i, &(_, t)) in by.iter().enumerate() {
+                acc += s.tri_area[t as usize];
+                if acc >= 0.5 * w {
+                    cut = (i + 1).clamp(1, by.len() - 1);
+                    break;
+                }
+            }
+            let mut a: Vec<u32> = by[..cut].iter().map(|x| x.1).collect();
+            let mut b: Vec<u32> = by[cut..].iter().map(|x| x.1).collect();
+            a.sort_unstable();
+            b.sort_unstable();
+            cands.push((a, b));
+        }
+    }
+    let built: Vec<Option<(Part, Part)>> = cands
+        .into_par_iter()
+        .map(|(a, b)| {
+            let (pa, pb) = rayon::join(
+                || build_part(s, p, opts, a, part.cuts.clone()),
+                || build_part(s, p, opts, b, part.cuts.clone()),
+            );
+            Some((pa?, pb?))
+        })
+        .collect();
+    built
+        .into_iter()
+        .flatten()
+        .enumerate()
+        .min_by(|(i, x), (j, y)| {
+            x.0.dev
+                .max(x.1.dev)
+                .total_cmp(&y.0.dev.max(y.1.dev))
+                .then(i.cmp(j))
+        })
+        .map(|(_, x)| x)
 }
 
 /// Decompose one object alone. `budget`: most hulls the quality loop may use.
