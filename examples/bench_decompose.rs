@@ -13,8 +13,8 @@
 //! ```text
 //! CARGO_TARGET_DIR=/work/main/target cargo run --release --example bench_decompose -- [--quick] [--no-python]
 //! ```
-//! `--quick`: three small fixture meshes (CI). Without the Python packages the reference
-//! columns read "n/a".
+//! `--quick`: three small fixture meshes (CI). `--ref-dir DIR`: keep (and resume) the Python
+//! reference runs in DIR. Without the Python packages the reference columns read "n/a".
 
 use interact3d::decompose::scene_aware::{metrics, SceneAware};
 use interact3d::decompose::{vhacd, DecomposeOptions, Hull};
@@ -194,13 +194,24 @@ fn main() {
     }
 
     // Reference engines through Python, all objects of all scenes at once.
-    let tmp = tempfile::tempdir().expect("temp dir");
+    let tmp_dir = tempfile::tempdir().expect("temp dir");
+    // `--ref-dir DIR`: keep the reference runs there (the Python runner resumes: CoACD takes
+    // minutes on a scan).
+    let ref_dir: Option<PathBuf> = args
+        .iter()
+        .position(|a| a == "--ref-dir")
+        .and_then(|i| args.get(i + 1))
+        .map(PathBuf::from);
+    if let Some(d) = &ref_dir {
+        std::fs::create_dir_all(d).expect("create --ref-dir");
+    }
+    let tmp: &Path = ref_dir.as_deref().unwrap_or(tmp_dir.path());
     let key = |si: usize, oi: usize| format!("s{si:02}_o{oi:02}");
     let mut py: BTreeMap<String, serde_json::Value> = BTreeMap::new();
     if !no_python {
         for (si, s) in scenes.iter().enumerate() {
             for (oi, (_, m)) in s.objects.iter().enumerate() {
-                write_obj(&tmp.path().join(format!("{}.obj", key(si, oi))), m);
+                write_obj(&tmp.join(format!("{}.obj", key(si, oi))), m);
             }
         }
         let script = root().join("tests/python/bench_reference.py");
@@ -209,14 +220,14 @@ fn main() {
         let status = std::process::Command::new("python3")
             .arg(&script)
             .arg("--in")
-            .arg(tmp.path())
+            .arg(tmp)
             .arg("--out")
-            .arg(tmp.path())
+            .arg(tmp)
             .status();
         eprintln!("python done in {:.0} s", t.elapsed().as_secs_f64());
         if let Ok(st) = status {
             if st.success() {
-                if let Ok(text) = std::fs::read_to_string(tmp.path().join("results.json")) {
+                if let Ok(text) = std::fs::read_to_string(tmp.join("results.json")) {
                     if let Ok(serde_json::Value::Object(m)) = serde_json::from_str(&text) {
                         py = m.into_iter().collect();
                     }
@@ -244,7 +255,7 @@ fn main() {
         }
         Run {
             seconds: r.get("seconds").and_then(|v| v.as_f64()),
-            hulls: read_hulls(&tmp.path().join(format!("{name}.{eng}.hulls.obj"))),
+            hulls: read_hulls(&tmp.join(format!("{name}.{eng}.hulls.obj"))),
             note: String::new(),
         }
     };

@@ -4,7 +4,8 @@
 Reads every `<name>.obj` in --in (triangles, metres, written by the bench), runs the engines
 that are installed (`pip install coacd vhacdx`) and writes, per mesh and engine,
 `<name>.<engine>.hulls.obj` into --out: one `o hull_<k>` group per hull, global 1-based
-indices. `results.json` in --out gives the wall time (s) of each run, or the error. The Rust
+indices, and `<name>.<engine>.json` with the wall time (s) or the error; a run whose json
+exists is not repeated (resumable). `results.json` in --out collects them all. The Rust
 bench measures the hulls with the same metric code as its own engines.
 
 Settings:
@@ -82,11 +83,25 @@ def main():
     a = ap.parse_args()
     os.makedirs(a.out, exist_ok=True)
     results = {}
+    previous = {}
+    try:
+        with open(os.path.join(a.out, "results.json")) as f:
+            previous = json.load(f)
+    except (OSError, ValueError):
+        pass
     names = sorted(n[:-4] for n in os.listdir(a.inp) if n.endswith(".obj"))
     for name in names:
         vs, fs = read_obj(os.path.join(a.inp, name + ".obj"))
         results[name] = {}
         for eng in a.engines.split(","):
+            done = os.path.join(a.out, f"{name}.{eng}.json")
+            if os.path.exists(done):  # resumable: a finished run is kept
+                with open(done) as f:
+                    results[name][eng] = json.load(f)
+                continue
+            if eng in previous.get(name, {}) and "seconds" in previous[name][eng]:
+                results[name][eng] = previous[name][eng]
+                continue
             try:
                 t0 = time.perf_counter()
                 hulls = ENGINES[eng](vs, fs)
@@ -95,6 +110,8 @@ def main():
                 results[name][eng] = {"seconds": dt, "hulls": len(hulls)}
             except Exception as e:  # missing package or engine failure: reported, not fatal
                 results[name][eng] = {"error": f"{type(e).__name__}: {e}"}
+            with open(done, "w") as f:
+                json.dump(results[name][eng], f)
             print(f"{name} {eng}: {results[name][eng]}", file=sys.stderr, flush=True)
     with open(os.path.join(a.out, "results.json"), "w") as f:
         json.dump(results, f, indent=1, sort_keys=True)
