@@ -14,7 +14,7 @@
 //! CARGO_TARGET_DIR=/work/main/target cargo run --release --example bench_decompose -- [--quick] [--no-python]
 //! ```
 //! `--quick`: three small fixture meshes (CI). `--ref-dir DIR`: keep (and resume) the Python
-//! reference runs in DIR. Without the Python packages the reference columns read "n/a".
+//! reference runs in DIR (with `--no-python`: only read its `results.json`). Without the Python packages the reference columns read "n/a".
 
 use interact3d::decompose::scene_aware::{metrics, SceneAware};
 use interact3d::decompose::{vhacd, DecomposeOptions, Hull};
@@ -224,15 +224,16 @@ fn main() {
             .arg("--out")
             .arg(tmp)
             .status();
-        eprintln!("python done in {:.0} s", t.elapsed().as_secs_f64());
-        if let Ok(st) = status {
-            if st.success() {
-                if let Ok(text) = std::fs::read_to_string(tmp.join("results.json")) {
-                    if let Ok(serde_json::Value::Object(m)) = serde_json::from_str(&text) {
-                        py = m.into_iter().collect();
-                    }
-                }
-            }
+        eprintln!(
+            "python done in {:.0} s ({:?})",
+            t.elapsed().as_secs_f64(),
+            status.map(|s| s.code())
+        );
+    }
+    // Results of this run, or (with `--no-python --ref-dir DIR`) of an earlier one.
+    if let Ok(text) = std::fs::read_to_string(tmp.join("results.json")) {
+        if let Ok(serde_json::Value::Object(m)) = serde_json::from_str(&text) {
+            py = m.into_iter().collect();
         }
     }
     let python_run = |name: &str, eng: &str| -> Run {
