@@ -10,19 +10,24 @@
 //!    δ ≤ tolerance that gives back the full hull's volume, is used alone when its surface
 //!    deviates from the mesh by at most the tolerance (p95 of sampled one-sided distances) and
 //!    by at most 3× the tolerance anywhere, so a cavity or an opening is never closed by it.
-//! 2. **Surface-patch hulls** otherwise. The surface is cut into patches by farthest-point
-//!    seeded Lloyd k-means on area-weighted triangle centroids with a normal term (weight
-//!    0.15·diagonal: opposite normals cost like 0.3·diagonal of distance), so patches do not
-//!    wrap a sharp edge or span both sides of a wall. Each patch's hull is made of up to
-//!    `max_vertices/2` surface vertices (farthest-point sampled) plus a copy of each pushed
-//!    inwards along the vertex normal by `d = clamp(0.45 × local wall thickness,
-//!    1.5·min_thickness, tolerance/2)` (thickness by an inward ray cast; open meshes with no hit
-//!    use the upper bound). A patch hull therefore lies in the material except for the sagitta
-//!    of its outer face, cavities stay open by construction, and every hull is at least `d`
-//!    thick and has at most `max_vertices` vertices. Quality loop: starting from half the
-//!    budget, the patch whose hull deviates most from the mesh (max of sampled distances) is
-//!    split by 2-means while that deviation exceeds the tolerance and the budget lasts.
-//!    Objects with neighbours keep `max_hulls/8` of the budget for step 3.
+//! 2. **Wall-segment / surface-patch hulls** otherwise. Change from the suggested design: a
+//!    pure surface patch on a thin wall bulges *through* the wall into the cavity (its chord),
+//!    and covering the outer and inner sides separately halves the budget per side. So each
+//!    triangle is clustered at its *mid-wall* position (centroid moved in by half the local
+//!    thickness, found by an inward ray cast, for walls up to 6 % of the diagonal thick;
+//!    otherwise by the push depth below), with an orientation term on `n·nᵀ` (sign-blind, so
+//!    both sides of a wall agree; a sharp edge costs like 0.14·diagonal of distance):
+//!    farthest-point seeded Lloyd k-means. A patch with both sides of a wall (≥ 10 % of its
+//!    area facing each way) becomes a wall segment: the hull of up to `max_vertices/2`
+//!    farthest-point-sampled surface vertices of each side. A one-sided patch (thick solid)
+//!    takes `max_vertices/2` surface vertices plus copies pushed inwards along the patch-local
+//!    vertex normal by `clamp(0.45 × local thickness, 1.5·min_thickness, tolerance/2)`. Either
+//!    way a hull lies in the material except for the sagitta where it bridges a concave side,
+//!    so cavities stay open, and it has at most `max_vertices` vertices. Quality loop: from
+//!    half the budget, the patch whose hull deviates most from the mesh (max of sampled
+//!    distances) is split while that exceeds the tolerance and the budget lasts; a split tries
+//!    2-means and area-median cuts across the two PCA axes and keeps the one whose worse half
+//!    deviates least. Objects with neighbours keep `max_hulls/8` of the budget for step 3.
 //! 3. **Neighbour refinement** at the composed pose. Every pair of hulls of different objects
 //!    closer than `clearance` (exact convex–convex queries in f64) is resolved: when the
 //!    convex hulls of the two patches' *surface points* are apart, both hulls are clipped by
