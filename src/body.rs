@@ -1,7 +1,7 @@
 //! Bodies: what a simulator gets for each object. The frame of a body is at its centre of mass
 //! with world-aligned axes at the composed pose; visual and collision geometry are expressed in it.
 
-use crate::decompose::{vhacd::Vhacd, DecomposeOptions, Decomposer, Hull};
+use crate::decompose::{scene_aware::SceneAware, vhacd::Vhacd, DecomposeOptions, Decomposer, Hull};
 use crate::error::{Error, Result};
 use crate::inertia::{self, Inertial, DEFAULT_DENSITY};
 use crate::mesh::{Mesh, VisualMesh};
@@ -68,14 +68,17 @@ pub struct Assembly {
 /// Which decomposition engine to use.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, clap::ValueEnum)]
 pub enum Engine {
-    /// parry's V-HACD, each object alone.
+    /// Scene-aware surface-patch hulls kept off the neighbours (see `decompose::scene_aware`).
     #[default]
+    SceneAware,
+    /// parry's V-HACD, each object alone.
     Vhacd,
 }
 
 impl Engine {
     pub fn decomposer(&self) -> Box<dyn Decomposer> {
         match self {
+            Engine::SceneAware => Box::new(SceneAware::new()),
             Engine::Vhacd => Box::new(Vhacd),
         }
     }

@@ -4,7 +4,9 @@
 //! [`finish`]: at most `max_hulls` hulls per object, at most `max_vertices` vertices per hull,
 //! no degenerate or paper-thin hulls.
 
+pub mod cache;
 mod hull;
+pub mod scene_aware;
 pub mod vhacd;
 
 pub use hull::Hull;
@@ -25,6 +27,13 @@ pub struct DecomposeOptions {
     pub resolution: u32,
     /// V-HACD concavity threshold (relative).
     pub concavity: f64,
+    /// Scene-aware engine: allowed one-sided distance from the hull surfaces to the mesh
+    /// (95th percentile), relative to the object's bounding-box diagonal.
+    pub tolerance: f64,
+    /// Scene-aware engine: smallest distance (m) kept between hulls of different objects.
+    pub clearance: f64,
+    /// Folder of the decomposition cache (content-addressed); `None`: no cache.
+    pub cache_dir: Option<std::path::PathBuf>,
 }
 
 impl Default for DecomposeOptions {
@@ -35,6 +44,9 @@ impl Default for DecomposeOptions {
             min_thickness: 2e-4,
             resolution: 64,
             concavity: 0.01,
+            tolerance: 0.01,
+            clearance: 1e-4,
+            cache_dir: None,
         }
     }
 }
@@ -45,6 +57,11 @@ pub trait Decomposer: Send + Sync {
     fn name(&self) -> &'static str;
     /// Hulls for every object of the scene (`objects` in the world frame, metres), in order.
     fn decompose(&self, objects: &[&Mesh], opts: &DecomposeOptions) -> Result<Vec<Vec<Hull>>>;
+    /// Notes on each object from the last `decompose` call (e.g. meshes that interpenetrate a
+    /// neighbour, hull overlaps left), for the caller to add to its warnings. Empty by default.
+    fn object_warnings(&self) -> Vec<Vec<String>> {
+        Vec::new()
+    }
 }
 
 /// Bring raw hull point sets within the limits: build hulls, drop degenerate ones, merge down to

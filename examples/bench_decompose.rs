@@ -1,0 +1,378 @@
+//! Decomposition bench: our scene-aware engine against parry's V-HACD and, when Python has
+//! them (`pip install coacd vhacdx`), CoACD and V-HACD 4 run by
+//! `tests/python/bench_reference.py`. Every engine's hulls are measured by the same code
+//! (`decompose::scene_aware::metrics`): surface distance = points sampled uniformly on the
+//! boundary of the union of the hulls (hull-surface points inside another hull of the same
+//! object are skipped), unsigned distance to the mesh surface, normalised by the mesh's
+//! bounding-box diagonal; volume = union of hulls (grid) / mesh volume; uncovered = mesh
+//! surface farther than 0.1 % of the diagonal outside every hull; cavity kept = the probe point
+//! of a container (half-way between floor and rim on the vertical axis) is outside all hulls.
+//! A second table gives, per multi-object scene, the deepest overlap between hulls of
+//! different objects at the composed pose (exact f64 convex queries).
+//!
+//! ```text
+//! CARGO_TARGET_DIR=/work/main/target cargo run --release --example bench_decompose -- [--quick] [--no-python]
+//! ```
+//! `--quick`: three small fixture meshes (CI). `--ref-dir DIR`: keep (and resume) the Python
+//! reference runs in DIR (with `--no-python`: only read its `results.json`). Without the Python packages the reference columns read "n/a".
+
+use interact3d::decompose::scene_aware::{metrics, SceneAware};
+use interact3d::decompose::{vhacd, DecomposeOptions, Hull};
+use interact3d::mesh::{Mesh, P3};
+use parry3d_f64::math::{Pose, Vector};
+use parry3d_f64::shape::ConvexPolyhedron;
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+struct Scene {
+    name: String,
+    objects: Vec<(String, Mesh)>,
+    /// Which objects get a row in the per-mesh table.
+    rows: Vec<usize>,
+}
+
+fn root() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+}
+
+fn shared() -> Option<PathBuf> {
+    [root().join("../shared"), root().join("../../shared")]
+        .into_iter()
+        .find(|p| p.join("datasets").is_dir())
+}
+
+fn fixture_scene(name: &str, rows: Vec<usize>) -> Option<Scene> {
+    scene_from(&root().join("fixtures").join(name), name, rows)
+}
+
+fn scene_from(path: &Path, name: &str, rows: Vec<usize>) -> Option<Scene> {
+    let limits = interact3d::io::Limits::default();
+    let scene = interact3d::scene::load(path, &limits).ok()?;
+    let prep = interact3d::prepare::prepare(&scene, &Default::default()).ok()?;
+    let objects = prep
+        .objects
+        .into_iter()
+        .map(|o| {
+            let label = o.label.clone().unwrap_or(o.name.clone());
+            (label, o.geometry)
+        })
+        .collect();
+    Some(Scene {
+        name: name.to_string(),
+        objects,
+        rows,
+    })
+}
+
+fn scan(rel: &str, scale: f64) -> Option<Scene> {
+    let path = shared()?.join("datasets/objects").join(rel);
+    let v = interact3d::io::load_visual(&path, &interact3d::io::Limits::default()).ok()?;
+    let mut m = v.geometry();
+    if scale != 1.0 {
+        for p in &mut m.vertices {
+            *p = P3::from(p.coords * scale);
+        }
+    }
+    let name = rel.split('/').nth(1).unwrap_or(rel).to_string();
+    Some(Scene {
+        name: name.clone(),
+        objects: vec![(name, m)],
+        rows: vec![0],
+    })
+}
+
+fn write_obj(path: &Path, m: &Mesh) {
+    let mut s = String::new();
+    for p in &m.vertices {
+        s += &format!("v {:?} {:?} {:?}\n", p.x, p.y, p.z);
+    }
+    for t in &m.triangles {
+        s += &format!("f {} {} {}\n", t[0] + 1, t[1] + 1, t[2] + 1);
+    }
+    std::fs::write(path, s).expect("write obj");
+}
+
+/// Hulls from a `bench_reference.py` output file (one `o` group per hull).
+fn read_hulls(path: &Path) -> Option<Vec<Hull>> {
+    let text = std::fs::read_to_string(path).ok()?;
+    let mut groups: Vec<Vec<P3>> = Vec::new();
+    let mut all: Vec<P3> = Vec::new();
+    let mut starts = Vec::new();
+    for line in text.lines() {
+        let p: Vec<&str> = line.split_whitespace().collect();
+        match p.first() {
+            Some(&"o") => starts.push(all.len()),
+            Some(&"v") => all.push(P3::new(
+                p[1].parse().ok()?,
+                p[2].parse().ok()?,
+                p[3].parse().ok()?,
+            )),
+            _ => {}
+        }
+    }
+    starts.push(all.len());
+    for w in starts.windows(2) {
+        groups.push(all[w[0]..w[1]].to_vec());
+    }
+    // Hulls as the reference engine gave them: their convex hull, no limits applied (so the
+    // vertex column shows what they produce); degenerate ones are dropped and counted.
+    Some(groups.iter().filter_map(|g| Hull::from_points(g)).collect())
+}
+
+#[derive(Default)]
+struct Run {
+    seconds: Option<f64>,
+    hulls: Option<Vec<Hull>>,
+    note: String,
+}
+
+fn deepest_overlap(sets: &[&Vec<Hull>]) -> (f64, usize) {
+    let poly = |h: &Hull| {
+        let v: Vec<Vector> = h.vertices.iter().map(interact3d::mesh::to_dvec).collect();
+        ConvexPolyhedron::from_convex_hull(&v)
+    };
+    let id = Pose::identity();
+    let (mut worst, mut count) = (0.0f64, 0usize);
+    for a in 0..sets.len() {
+        for b in a + 1..sets.len() {
+            for ha in sets[a] {
+                for hb in sets[b] {
+                    if !ha.aabb.intersects(&hb.aabb, 0.0) {
+                        continue;
+                    }
+                    if let (Some(x), Some(y)) = (poly(ha), poly(hb)) {
+                        if let Ok(Some(c)) = parry3d_f64::query::contact(&id, &x, &id, &y, 0.0) {
+                            if c.dist < 0.0 {
+                                worst = worst.max(-c.dist);
+                                count += 1;
+                            }
+                        }
+                    }
+                }
+            }
+        }
+    }
+    (worst, count)
+}
+
+fn main() {
+    let args: Vec<String> = std::env::args().collect();
+    let quick = args.iter().any(|a| a == "--quick");
+    let no_python = args.iter().any(|a| a == "--no-python");
+    let opts = DecomposeOptions::default();
+
+    let mut scenes: Vec<Scene> = Vec::new();
+    if quick {
+        scenes.extend(fixture_scene("ball_bowl", vec![0]));
+        scenes.extend(fixture_scene("pen_mug", vec![0, 1]));
+    } else {
+        scenes.extend(fixture_scene("ball_bowl", vec![0, 1]));
+        scenes.extend(fixture_scene("pen_mug", vec![0, 1]));
+        scenes.extend(fixture_scene("fruit_basket", vec![0, 1]));
+        scenes.extend(fixture_scene("box_tray", vec![0, 1]));
+        for (rel, scale) in [
+            ("ycb/024_bowl/textured.obj", 1.0),
+            ("ycb/025_mug/textured.obj", 1.0),
+            ("gso/Room_Essentials_Mug_White_Yellow/model.obj", 1.0),
+            ("ycb/065-j_cups/textured.obj", 1.0),
+            ("pybullet_data/tray/tray_textured4.obj", 0.5),
+            ("gso/Reebok_TURBO_RC/model.obj", 1.0),
+            ("ycb/014_lemon/textured.obj", 1.0),
+        ] {
+            match scan(rel, scale) {
+                Some(s) => scenes.push(s),
+                None => eprintln!("skipped {rel} (shared datasets not found)"),
+            }
+        }
+        if let Some(sh) = shared() {
+            for s in ["food/00001_lemon_bowl", "toys/00007_ball_mug"] {
+                let p = sh.join("datasets/scenes").join(s);
+                scenes.extend(scene_from(&p, s.split('/').nth(1).unwrap(), vec![]));
+            }
+        }
+    }
+
+    // Reference engines through Python, all objects of all scenes at once.
+    let tmp_dir = tempfile::tempdir().expect("temp dir");
+    // `--ref-dir DIR`: keep the reference runs there (the Python runner resumes: CoACD takes
+    // minutes on a scan).
+    let ref_dir: Option<PathBuf> = args
+        .iter()
+        .position(|a| a == "--ref-dir")
+        .and_then(|i| args.get(i + 1))
+        .map(PathBuf::from);
+    if let Some(d) = &ref_dir {
+        std::fs::create_dir_all(d).expect("create --ref-dir");
+    }
+    let tmp: &Path = ref_dir.as_deref().unwrap_or(tmp_dir.path());
+    let key = |si: usize, oi: usize| format!("s{si:02}_o{oi:02}");
+    let mut py: BTreeMap<String, serde_json::Value> = BTreeMap::new();
+    if !no_python {
+        for (si, s) in scenes.iter().enumerate() {
+            for (oi, (_, m)) in s.objects.iter().enumerate() {
+                write_obj(&tmp.join(format!("{}.obj", key(si, oi))), m);
+            }
+        }
+        let script = root().join("tests/python/bench_reference.py");
+        eprintln!("running CoACD / V-HACD 4 via {} ...", script.display());
+        let t = Instant::now();
+        let status = std::process::Command::new("python3")
+            .arg(&script)
+            .arg("--in")
+            .arg(tmp)
+            .arg("--out")
+            .arg(tmp)
+            .status();
+        eprintln!(
+            "python done in {:.0} s ({:?})",
+            t.elapsed().as_secs_f64(),
+            status.map(|s| s.code())
+        );
+    }
+    // Results of this run, or (with `--no-python --ref-dir DIR`) of an earlier one.
+    if let Ok(text) = std::fs::read_to_string(tmp.join("results.json")) {
+        if let Ok(serde_json::Value::Object(m)) = serde_json::from_str(&text) {
+            py = m.into_iter().collect();
+        }
+    }
+    let python_run = |name: &str, eng: &str| -> Run {
+        let Some(r) = py.get(name).and_then(|v| v.get(eng)) else {
+            return Run {
+                note: "n/a".into(),
+                ..Default::default()
+            };
+        };
+        if let Some(e) = r.get("error") {
+            let e = e.as_str().unwrap_or("error");
+            return Run {
+                note: if e.contains("ModuleNotFound") {
+                    "n/a".into()
+                } else {
+                    format!("failed: {}", e.chars().take(60).collect::<String>())
+                },
+                ..Default::default()
+            };
+        }
+        Run {
+            seconds: r.get("seconds").and_then(|v| v.as_f64()),
+            hulls: read_hulls(&tmp.join(format!("{name}.{eng}.hulls.obj"))),
+            note: String::new(),
+        }
+    };
+
+    println!("## Per mesh\n");
+    println!("Surface distance: hull-union boundary → mesh surface, % of the bbox diagonal. Limits: ≤ {} hulls (ours, V-HACD 4; CoACD at its defaults has none), ≤ {} vertices.\n", opts.max_hulls, opts.max_vertices);
+    println!("| mesh | triangles | engine | time (s) | hulls | max verts | hull vol / mesh vol | dist mean % | dist p95 % | dist max % | uncovered % | cavity kept |");
+    println!("|---|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|---|");
+    let mut scene_runs: Vec<BTreeMap<&'static str, Vec<Option<Vec<Hull>>>>> = Vec::new();
+    for (si, s) in scenes.iter().enumerate() {
+        let mut per_engine: BTreeMap<&'static str, Vec<Option<Vec<Hull>>>> = BTreeMap::new();
+        for (oi, (oname, m)) in s.objects.iter().enumerate() {
+            let mut runs: Vec<(&'static str, Run)> = Vec::new();
+            let engine = SceneAware::new();
+            let t = Instant::now();
+            let ours = engine
+                .run(&[m], &opts)
+                .map(|r| r.0.into_iter().next().unwrap_or_default());
+            runs.push((
+                "scene_aware",
+                Run {
+                    seconds: Some(t.elapsed().as_secs_f64()),
+                    hulls: ours.ok(),
+                    note: String::new(),
+                },
+            ));
+            let t = Instant::now();
+            let vh = vhacd::decompose_one(m, &opts);
+            runs.push((
+                "parry V-HACD",
+                Run {
+                    seconds: Some(t.elapsed().as_secs_f64()),
+                    hulls: Some(vh),
+                    note: String::new(),
+                },
+            ));
+            runs.push(("CoACD", python_run(&key(si, oi), "coacd")));
+            runs.push(("V-HACD 4", python_run(&key(si, oi), "vhacd")));
+            for (eng, r) in &runs {
+                per_engine.entry(eng).or_default().push(r.hulls.clone());
+            }
+            if !s.rows.contains(&oi) {
+                continue;
+            }
+            let label = if s.objects.len() > 1 {
+                format!("{} ({})", s.name, oname)
+            } else {
+                s.name.clone()
+            };
+            for (eng, r) in &runs {
+                let Some(h) = &r.hulls else {
+                    println!(
+                        "| {label} | {} | {eng} | {} | | | | | | | | |",
+                        m.triangles.len(),
+                        r.note
+                    );
+                    continue;
+                };
+                let q = metrics::measure(m, h);
+                println!(
+                    "| {label} | {} | {eng} | {} | {} | {} | {:.2} | {:.2} | {:.2} | {:.2} | {:.1} | {} |",
+                    m.triangles.len(),
+                    r.seconds.map(|s| format!("{s:.2}")).unwrap_or("?".into()),
+                    q.hulls,
+                    q.max_vertices,
+                    q.volume_ratio,
+                    q.dist_mean * 100.0,
+                    q.dist_p95 * 100.0,
+                    q.dist_max * 100.0,
+                    q.uncovered * 100.0,
+                    match q.cavity_kept {
+                        Some(true) => "yes",
+                        Some(false) => "**no**",
+                        None => "–",
+                    }
+                );
+            }
+        }
+        scene_runs.push(per_engine);
+    }
+
+    println!("\n## Scenes at the composed pose\n");
+    println!("Deepest overlap between hulls of different objects (mm) and the number of overlapping hull pairs. Ours: the scene-aware engine on the whole scene; the others decompose each object alone.\n");
+    println!("| scene | engine | time (s) | overlap (mm) | overlapping pairs |");
+    println!("|---|---|---:|---:|---:|");
+    for (si, s) in scenes.iter().enumerate() {
+        if s.objects.len() < 2 {
+            continue;
+        }
+        let meshes: Vec<&Mesh> = s.objects.iter().map(|o| &o.1).collect();
+        let engine = SceneAware::new();
+        let t = Instant::now();
+        let (hulls, rep) = engine.run(&meshes, &opts).expect("scene-aware run");
+        let secs = t.elapsed().as_secs_f64();
+        let refs: Vec<&Vec<Hull>> = hulls.iter().collect();
+        let (w, c) = deepest_overlap(&refs);
+        println!(
+            "| {} | scene_aware | {secs:.2} | {:.3} | {c} |",
+            s.name,
+            w * 1e3
+        );
+        let notes: Vec<String> = rep.objects.iter().flat_map(|o| o.warnings()).collect();
+        if !notes.is_empty() {
+            eprintln!("{}: {}", s.name, notes.join("; "));
+        }
+        for (eng, sets) in &scene_runs[si] {
+            if *eng == "scene_aware" {
+                continue;
+            }
+            if sets.iter().any(|h| h.is_none()) {
+                println!("| {} | {eng} | | n/a | |", s.name);
+                continue;
+            }
+            let refs: Vec<&Vec<Hull>> = sets.iter().map(|h| h.as_ref().unwrap()).collect();
+            let (w, c) = deepest_overlap(&refs);
+            println!("| {} | {eng} | | {:.3} | {c} |", s.name, w * 1e3);
+        }
+    }
+}

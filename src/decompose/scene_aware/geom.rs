@@ -1,0 +1,333 @@
+//! Geometry helpers of the scene-aware engine: the mesh as a queryable surface (f64 parry
+//! `TriMesh` for distances, inside tests and ray casts), deterministic surface sampling, plane
+//! clipping of hulls and parry conversions.
+
+use crate::decompose::Hull;
+use crate::mesh::{to_dvec, triangle_area, Aabb, Mesh, P3, V3};
+use parry3d_f64::math::{Pose, Vector};
+use parry3d_f64::query::{PointQuery, Ray, RayCast};
+use parry3d_f64::shape::{ConvexPolyhedron, TriMesh, TriMeshFlags};
+
+/// A mesh prepared for queries, with per-triangle and per-vertex data.
+pub struct Surface {
+    /// The mesh (winding flipped when it enclosed a negative volume, so normals face out).
+    pub mesh: Mesh,
+    pub tri: TriMesh,
+    /// Watertight and consistently oriented: inside tests are meaningful.
+    pub closed: bool,
+    pub aabb: Aabb,
+    pub diag: f64,
+    pub tri_normal: Vec<V3>,
+    pub tri_area: Vec<f64>,
+    pub tri_centroid: Vec<P3>,
+    /// Area-weighted vertex normals (unit; zero for unused vertices).
+    pub vert_normal: Vec<V3>,
+}
+
+impl Surface {
+    /// `None` for a mesh without triangles.
+    pub fn new(mesh: &Mesh) -> Option<Surface> {
+        let aabb = mesh.aabb()?;
+        if mesh.triangles.is_empty() {
+            return None;
+        }
+        let mut mesh = mesh.clone();
+        let closed = mesh.is_closed();
+        if closed && mesh.signed_volume() < 0.0 {
+            for t in &mut mesh.triangles {
+                t.swap(1, 2);
+            }
+        }
+        let (v, t) = mesh.to_parry();
+        let tri = TriMesh::with_flags(v, t, TriMeshFlags::ORIENTED).ok()?;
+        let n = mesh.triangles.len();
+        let mut tri_normal = Vec::with_capacity(n);
+        let mut tri_area = Vec::with_capacity(n);
+        let mut tri_centroid = Vec::with_capacity(n);
+        let mut vert_normal = vec![V3::zeros(); mesh.vertices.len()];
+        for i in 0..n {
+            let [a, b, c] = mesh.triangle(i);
+            let cr = (b - a).cross(&(c - a));
+            let len = cr.norm();
+            let nrm = if len > 0.0 { cr / len } else { V3::zeros() };
+            tri_normal.push(nrm);
+            tri_area.push(0.5 * len);
+            tri_centroid.push(P3::from((a.coords + b.coords + c.coords) / 3.0));
+            for &k in &mesh.triangles[i] {
+                vert_normal[k as usize] += cr; // area-weighted (|cr| = 2·area)
+            }
+        }
+        for vn in &mut vert_normal {
+            let l = vn.norm();
+            if l > 0.0 {
+                *vn /= l;
+            }
+        }
+        Some(Surface {
+            diag: aabb.diagonal(),
+            mesh,
+            tri,
+            closed,
+            aabb,
+            tri_normal,
+            tri_area,
+            tri_centroid,
+            vert_normal,
+        })
+    }
+
+    /// Unsigned distance from `p` to the surface.
+    pub fn distance(&self, p: &P3) -> f64 {
+        let q = to_dvec(p);
+        let proj = self.tri.project_point(&Pose::identity(), q, false);
+        (proj.point - q).length()
+    }
+
+    /// Whether `p` is inside the closed mesh (always `false` for open meshes).
+    pub fn contains(&self, p: &P3) -> bool {
+        self.closed
+            && self
+                .tri
+                .project_point(&Pose::identity(), to_dvec(p), false)
+                .is_inside
+    }
+
+    /// Distance along a ray from `p` in direction `dir` (unit) to the first surface hit within
+    /// `max`; `None` when nothing is hit.
+    pub fn ray(&self, p: &P3, dir: &V3, max: f64) -> Option<f64> {
+        let ray = Ray::new(to_dvec(p), Vector::new(dir.x, dir.y, dir.z));
+        self.tri.cast_ray(&Pose::identity(), &ray, max, false)
+    }
+
+    /// Material thickness under vertex `p` with outward normal `n`: an inward ray cast started
+    /// just below the surface; `f64::INFINITY` when nothing is hit within `max` (open meshes).
+    pub fn thickness(&self, p: &P3, n: &V3, max: f64) -> f64 {
+        let eps = 1e-7 * self.diag;
+        let start = p - n * eps;
+        self.ray(&start, &(-n), max)
+            .map(|t| t + eps)
+            .unwrap_or(f64::INFINITY)
+    }
+}
+
+/// SplitMix64: a tiny deterministic generator for sampling.
+pub struct SplitMix(pub u64);
+
+impl SplitMix {
+    pub fn next_u64(&mut self) -> u64 {
+        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
+        let mut z = self.0;
+        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+        z ^ (z >> 31)
+    }
+    /// Uniform in [0, 1).
+    pub fn next_f64(&mut self) -> f64 {
+        (self.next_u64() >> 11) as f64 / (1u64 << 53) as f64
+    }
+}
+
+/// `n` points on a triangle set, stratified by area (deterministic for a given `seed`).
+pub fn sample_triangles(tris: &[[P3; 3]], n: usize, seed: u64) -> Vec<P3> {
+    let areas: Vec<f64> = tris.iter().map(triangle_area).collect();
+    let total: f64 = areas.iter().sum();
+    if n == 0 || tris.is_empty() || !(total > 0.0) {
+        return Vec::new();
+    }
+    let mut rng = SplitMix(seed);
+    let mut out = Vec::with_capacity(n);
+    let mut acc = 0.0;
+    let mut k = 0usize;
+    for (t, a) in tris.iter().zip(&areas) {
+        acc += a;
+        // Stratified: sample k sits at the area position (k + 0.5)/n · total.
+        while k < n && (k as f64 + 0.5) / n as f64 * total <= acc {
+            let (mut u, mut v) = (rng.next_f64(), rng.next_f64());
+            if u + v > 1.0 {
+                u = 1.0 - u;
+                v = 1.0 - v;
+            }
+            out.push(t[0] + (t[1] - t[0]) * u + (t[2] - t[0]) * v);
+            k += 1;
+        }
+    }
+    out
+}
+
+/// `n` points on the surface of a hull.
+pub fn sample_hull(h: &Hull, n: usize, seed: u64) -> Vec<P3> {
+    let tris: Vec<[P3; 3]> = h
+        .triangles
+        .iter()
+        .map(|t| {
+            [
+                h.vertices[t[0] as usize],
+                h.vertices[t[1] as usize],
+                h.vertices[t[2] as usize],
+            ]
+        })
+        .collect();
+    sample_triangles(&tris, n, seed)
+}
+
+/// The part of a hull where `n·x ≤ c`; `None` when nothing with volume remains.
+pub fn clip(h: &Hull, n: &V3, c: f64) -> Option<Hull> {
+    let side: Vec<f64> = h.vertices.iter().map(|v| n.dot(&v.coords) - c).collect();
+    if side.iter().all(|&s| s <= 0.0) {
+        return Some(h.clone());
+    }
+    let mut pts: Vec<P3> = h
+        .vertices
+        .iter()
+        .zip(&side)
+        .filter(|(_, &s)| s <= 0.0)
+        .map(|(v, _)| *v)
+        .collect();
+    let mut edges: Vec<(u32, u32)> = h
+        .triangles
+        .iter()
+        .flat_map(|t| [(t[0], t[1]), (t[1], t[2]), (t[2], t[0])])
+        .map(|(a, b)| (a.min(b), a.max(b)))
+        .collect();
+    edges.sort_unstable();
+    edges.dedup();
+    for (a, b) in edges {
+        let (sa, sb) = (side[a as usize], side[b as usize]);
+        if (sa < 0.0 && sb > 0.0) || (sa > 0.0 && sb < 0.0) {
+            let t = sa / (sa - sb);
+            let (pa, pb) = (h.vertices[a as usize], h.vertices[b as usize]);
+            pts.push(pa + (pb - pa) * t);
+        }
+    }
+    Hull::from_points(&pts)
+}
+
+/// A hull as a parry convex polyhedron (f64).
+pub fn polyhedron(h: &Hull) -> Option<ConvexPolyhedron> {
+    let v: Vec<Vector> = h.vertices.iter().map(to_dvec).collect();
+    ConvexPolyhedron::from_convex_mesh(v.clone(), &h.triangles)
+        .or_else(|| ConvexPolyhedron::from_convex_hull(&v))
+}
+
+/// A point set as a parry convex polyhedron; a flat set is given a slab of thickness `fat`
+/// along `dir` so it still has a volume.
+pub fn point_polyhedron(pts: &[P3], dir: &V3, fat: f64) -> Option<ConvexPolyhedron> {
+    let mut v: Vec<Vector> = pts.iter().map(to_dvec).collect();
+    if let Some(p) = ConvexPolyhedron::from_convex_hull(&v) {
+        if Hull::from_points(pts).is_some() {
+            return Some(p);
+        }
+    }
+    let d = Vector::new(dir.x, dir.y, dir.z) * fat;
+    let shifted: Vec<Vector> = v.iter().map(|p| *p - d).collect();
+    v.extend(shifted);
+    ConvexPolyhedron::from_convex_hull(&v)
+}
+
+/// Signed separation of two convex shapes: distance when apart, minus the penetration depth
+/// when they overlap; with the contact normal (from the first towards the second) and the
+/// witness points.
+pub fn separation(a: &ConvexPolyhedron, b: &ConvexPolyhedron) -> Option<(f64, V3, P3, P3)> {
+    let id = Pose::identity();
+    let c = parry3d_f64::query::contact(&id, a, &id, b, f64::MAX / 4.0).ok()??;
+    let n = V3::new(c.normal1.x, c.normal1.y, c.normal1.z);
+    Some((
+        c.dist,
+        n,
+        P3::new(c.point1.x, c.point1.y, c.point1.z),
+        P3::new(c.point2.x, c.point2.y, c.point2.z),
+    ))
+}
+
+/// Distance between two convex shapes (0 when they touch or overlap).
+pub fn distance(a: &ConvexPolyhedron, b: &ConvexPolyhedron) -> f64 {
+    let id = Pose::identity();
+    parry3d_f64::query::distance(&id, a, &id, b)
+        .map(|d| d.distance)
+        .unwrap_or(0.0)
+}
+
+/// Farthest-point sampling: indices of at most `k` points of `pts`, the first the point
+/// farthest from their centroid (ties to the lower index). Deterministic.
+pub fn farthest_points(pts: &[P3], k: usize) -> Vec<usize> {
+    if pts.len() <= k {
+        return (0..pts.len()).collect();
+    }
+    let c = pts.iter().fold(V3::zeros(), |a, p| a + p.coords) / pts.len() as f64;
+    let first = (0..pts.len())
+        .max_by(|&i, &j| {
+            (pts[i].coords - c)
+                .norm_squared()
+                .total_cmp(&(pts[j].coords - c).norm_squared())
+                .then(j.cmp(&i))
+        })
+        .unwrap();
+    let mut kept = vec![first];
+    let mut dist: Vec<f64> = pts
+        .iter()
+        .map(|p| (p - pts[first]).norm_squared())
+        .collect();
+    while kept.len() < k {
+        let (best, d) = dist
+            .iter()
+            .enumerate()
+            .max_by(|a, b| a.1.total_cmp(b.1).then(b.0.cmp(&a.0)))
+            .unwrap();
+        if *d <= 0.0 {
+            break;
+        }
+        kept.push(best);
+        for (i, p) in pts.iter().enumerate() {
+            dist[i] = dist[i].min((p - pts[best]).norm_squared());
+        }
+    }
+    kept
+}
+
+/// At most `k` vertices of a convex hull chosen greedily to lose the least: seeded by
+/// farthest-point sampling, then repeatedly the vertex farthest outside the current hull.
+pub fn greedy_hull(full: &Hull, k: usize) -> Option<Hull> {
+    if full.vertices.len() <= k {
+        return Some(full.clone());
+    }
+    let pts = &full.vertices;
+    let mut kept = farthest_points(pts, 8.min(k));
+    let mut h = Hull::from_points(&kept.iter().map(|&i| pts[i]).collect::<Vec<_>>())?;
+    while kept.len() < k {
+        let best = (0..pts.len())
+            .map(|i| (i, h.plane_distance(&pts[i])))
+            .max_by(|a, b| a.1.total_cmp(&b.1).then(b.0.cmp(&a.0)))?;
+        if best.1 <= 1e-12 * full.aabb.diagonal() {
+            break;
+        }
+        kept.push(best.0);
+        h = Hull::from_points(&kept.iter().map(|&i| pts[i]).collect::<Vec<_>>())?;
+    }
+    Some(h)
+}
+
+/// Unit vertex normals of a hull (sum of incident face normals).
+pub fn hull_vertex_normals(h: &Hull) -> Vec<V3> {
+    let mut n = vec![V3::zeros(); h.vertices.len()];
+    for t in &h.triangles {
+        let [a, b, c] = [
+            h.vertices[t[0] as usize],
+            h.vertices[t[1] as usize],
+            h.vertices[t[2] as usize],
+        ];
+        let f = (b - a).cross(&(c - a));
+        let l = f.norm();
+        if l > 0.0 {
+            for &k in t {
+                n[k as usize] += f / l;
+            }
+        }
+    }
+    for v in &mut n {
+        let l = v.norm();
+        if l > 0.0 {
+            *v /= l;
+        }
+    }
+    n
+}
