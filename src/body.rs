@@ -112,10 +112,12 @@ pub fn assemble(
 ) -> Result<Assembly> {
     let meshes: Vec<&Mesh> = prepared.objects.iter().map(|o| &o.geometry).collect();
     let hull_sets = engine.decompose(&meshes, dopts)?;
+    let notes = engine.object_warnings();
     let mut bodies = Vec::with_capacity(prepared.objects.len());
-    for (o, hulls) in prepared.objects.iter().zip(hull_sets) {
+    for (k, (o, hulls)) in prepared.objects.iter().zip(hull_sets).enumerate() {
         let density = o.physical.density.unwrap_or(DEFAULT_DENSITY);
         let mut warnings = o.warnings.clone();
+        warnings.extend(notes.get(k).into_iter().flatten().cloned());
         if hulls.is_empty() {
             return Err(Error::input(
                 source,

@@ -35,6 +35,9 @@ struct CheckArgs {
     /// Largest penetration between collision hulls of different objects at the composed pose (m).
     #[arg(long, default_value_t = 1e-4)]
     max_penetration: f64,
+    /// Largest penetration between the visual meshes of different objects (m).
+    #[arg(long, default_value_t = 1e-4)]
+    max_visual_penetration: f64,
     /// Largest drift while settling, as a fraction of the object's bounding-box diagonal.
     #[arg(long, default_value_t = 0.1)]
     max_drift: f64,
@@ -66,6 +69,7 @@ impl CheckArgs {
         o.settle.max_rest_rotation_deg = self.max_rest_rotation;
         o.settle.max_rest_penetration = self.max_rest_penetration;
         o.visual_metrics = !self.no_visual_metrics;
+        o.max_visual_penetration = self.max_visual_penetration;
         o
     }
 }
@@ -92,7 +96,7 @@ struct BuildArgs {
     #[arg(long = "size", value_name = "NAME=METRES", value_parser = parse_size)]
     sizes: Vec<(String, f64)>,
     /// Convex decomposition engine.
-    #[arg(long, value_enum, default_value_t = Engine::Vhacd)]
+    #[arg(long, value_enum, default_value_t = Engine::SceneAware)]
     engine: Engine,
     /// Most convex hulls per object.
     #[arg(long, default_value_t = 32)]
@@ -103,6 +107,9 @@ struct BuildArgs {
     /// V-HACD voxel resolution.
     #[arg(long, default_value_t = 64)]
     vhacd_resolution: u32,
+    /// Cache decompositions here (keyed by a hash of the meshes and options).
+    #[arg(long, value_name = "DIR")]
+    decompose_cache: Option<PathBuf>,
 }
 
 #[derive(Args)]
@@ -150,6 +157,7 @@ impl BuildArgs {
         o.decompose.max_hulls = self.max_hulls;
         o.decompose.max_vertices = self.max_hull_vertices;
         o.decompose.resolution = self.vhacd_resolution;
+        o.decompose.cache_dir = self.decompose_cache.clone();
         o
     }
 }

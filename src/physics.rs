@@ -362,10 +362,13 @@ pub fn settle(bodies: &[SimBody], opts: &SettleOptions) -> Result<SettleReport, 
         let left = !b.fixed
             && !body_supports.is_empty()
             && !body_supports.iter().any(|k| touching.contains(k));
+        // Touching the floor is only "ending on the floor" when the body no longer touches what it
+        // started on: an item resting in a thin-bottomed bowl is within millimetres of the floor.
         let ended_on_floor = !b.fixed
             && !body_supports.is_empty()
             && !supports.contains(&n)
-            && touching.contains(&n);
+            && touching.contains(&n)
+            && left;
         let (init_pen, init_with) = start.penetration[i];
         let (pen, pen_with) = rest_pen[i];
 

@@ -33,13 +33,15 @@ fn export_validated(scene: &Path) -> Outcome {
     Outcome { code, report, out }
 }
 
-/// Objects Rapier failed (any failed check naming them).
+/// Objects Rapier failed dynamically (a failed settle or rest check names them).
 fn rapier_failed(report: &serde_json::Value) -> Vec<String> {
     let mut v: Vec<String> = report["validation"]["checks"]
         .as_array()
         .unwrap()
         .iter()
-        .filter(|c| !c["passed"].as_bool().unwrap())
+        .filter(|c| {
+            !c["passed"].as_bool().unwrap() && (c["name"] == "settle" || c["name"] == "rest")
+        })
         .flat_map(|c| {
             c["subject"]
                 .as_str()
@@ -78,8 +80,8 @@ fn mujoco_and_pybullet_agree_with_the_rapier_verdict_on_every_fixture() {
         let pb = python_json("check_pybullet.py", &[dir.to_str().unwrap()]);
         let name = scene.file_name().unwrap().to_string_lossy().to_string();
         let failed = rapier_failed(&o.report);
-        if o.code == 0 {
-            // Pass: from the exported (settled) poses nothing moves and nothing overlaps.
+        if failed.is_empty() {
+            // Dynamic pass: nothing moves and nothing overlaps in the other engines either.
             assert!(
                 engine_flagged(&mj).is_empty(),
                 "{name}: Rapier passed but MuJoCo moved {:?}: {}",
@@ -150,16 +152,21 @@ fn mujoco_and_pybullet_agree_with_the_rapier_verdict_on_every_fixture() {
 fn interpenetrating_fixture_fails_on_the_measured_depth() {
     let o = export_validated(&root().join("fixtures/fail_interpenetrating"));
     assert_eq!(o.code, 1);
-    let c = o.report["validation"]["checks"]
-        .as_array()
-        .unwrap()
+    // The top box is sunk 3 mm into the base (fixtures/fail_interpenetrating/README.md): the
+    // meshes say so; the scene-aware hulls are cut apart, so they overlap by at most 0.1 mm.
+    let checks = o.report["validation"]["checks"].as_array().unwrap();
+    let c = checks
         .iter()
-        .find(|c| c["name"] == "static_penetration")
+        .find(|c| c["name"] == "visual_penetration")
         .unwrap()
         .clone();
     assert_eq!(c["passed"], false);
-    // The top box is sunk 3 mm into the base (fixtures/fail_interpenetrating/README.md).
-    assert!((c["value"].as_f64().unwrap() - 0.003).abs() < 1e-6, "{c}");
+    assert!((c["value"].as_f64().unwrap() - 0.003).abs() < 1e-4, "{c}");
+    let h = checks
+        .iter()
+        .find(|c| c["name"] == "static_penetration")
+        .unwrap();
+    assert!(h["value"].as_f64().unwrap() <= 1e-4, "hulls cut apart: {h}");
     let pair = &o.report["validation"]["pairs"][0];
     assert!(
         (pair["visual"]["max_penetration_depth"].as_f64().unwrap() - 0.003).abs() < 1e-4,

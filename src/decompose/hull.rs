@@ -92,34 +92,82 @@ impl Hull {
         }
         let max_vertices = max_vertices.max(4);
         let pts = &self.vertices;
-        let c = self.aabb.center();
-        // Seed with the vertex farthest from the centre, then farthest from the kept set.
-        let mut kept = vec![(0..pts.len())
-            .max_by(|&i, &j| {
-                (pts[i] - c)
-                    .norm_squared()
-                    .total_cmp(&(pts[j] - c).norm_squared())
-                    .then(j.cmp(&i))
-            })
-            .unwrap()];
-        let mut dist: Vec<f64> = pts
-            .iter()
-            .map(|p| (p - pts[kept[0]]).norm_squared())
-            .collect();
-        while kept.len() < max_vertices {
-            let (k, _) = dist
-                .iter()
-                .enumerate()
-                .max_by(|a, b| a.1.total_cmp(b.1).then(b.0.cmp(&a.0)))
-                .unwrap();
-            kept.push(k);
-            for (i, p) in pts.iter().enumerate() {
-                dist[i] = dist[i].min((p - pts[k]).norm_squared());
+        // Large flat faces are what objects rest on (a cut fruit, a box bottom): keep up to 8
+        // well-spread vertices of each facet covering at least 2% of the area, largest first,
+        // using at most half of the budget, so farthest-point sampling cannot drop them.
+        let mut kept: Vec<usize> = Vec::new();
+        for facet in self.large_facets(0.02) {
+            if kept.len() + 3 > max_vertices / 2 {
+                break;
+            }
+            let take = 8.min(max_vertices / 2 - kept.len());
+            for i in farthest_points(pts, &facet, &[], take) {
+                if !kept.contains(&i) {
+                    kept.push(i);
+                }
             }
         }
+        if kept.is_empty() {
+            // Seed with the vertex farthest from the centre.
+            let c = self.aabb.center();
+            kept.push(
+                (0..pts.len())
+                    .max_by(|&i, &j| {
+                        (pts[i] - c)
+                            .norm_squared()
+                            .total_cmp(&(pts[j] - c).norm_squared())
+                            .then(j.cmp(&i))
+                    })
+                    .unwrap(),
+            );
+        }
+        let all: Vec<usize> = (0..pts.len()).collect();
+        let more = max_vertices - kept.len();
+        let extra = farthest_points(pts, &all, &kept, more);
+        kept.extend(extra);
         kept.sort_unstable();
+        kept.dedup();
         let sub: Vec<P3> = kept.iter().map(|&i| pts[i]).collect();
         Hull::from_points(&sub)
+    }
+
+    /// Vertex sets of the planar facets (coplanar triangles merged) whose area is at least
+    /// `min_fraction` of the hull's area, largest first.
+    fn large_facets(&self, min_fraction: f64) -> Vec<Vec<usize>> {
+        let scale = self.aabb.diagonal().max(1e-300);
+        let mut facets: Vec<(V3, f64, f64, Vec<usize>)> = Vec::new(); // normal, offset, area, vertices
+        let mut total = 0.0;
+        for i in 0..self.triangles.len() {
+            let t = self.triangles[i];
+            let [a, b, c] = [t[0], t[1], t[2]].map(|k| self.vertices[k as usize]);
+            let n = (b - a).cross(&(c - a));
+            let area = 0.5 * n.norm();
+            total += area;
+            if area <= 0.0 {
+                continue;
+            }
+            let n = n.normalize();
+            let d = n.dot(&a.coords);
+            let f = facets
+                .iter_mut()
+                .find(|f| f.0.dot(&n) > 1.0 - 1e-6 && (f.1 - d).abs() < 1e-7 * scale);
+            let f = match f {
+                Some(f) => f,
+                None => {
+                    facets.push((n, d, 0.0, Vec::new()));
+                    facets.last_mut().unwrap()
+                }
+            };
+            f.2 += area;
+            for k in t {
+                if !f.3.contains(&(k as usize)) {
+                    f.3.push(k as usize);
+                }
+            }
+        }
+        facets.retain(|f| f.2 >= min_fraction * total && f.3.len() >= 3);
+        facets.sort_by(|a, b| b.2.total_cmp(&a.2));
+        facets.into_iter().map(|f| f.3).collect()
     }
 
     /// The hull as a mesh.
@@ -132,6 +180,45 @@ impl Hull {
         Hull::from_mesh(self.mesh().transformed(&iso.to_homogeneous()))
             .expect("rigid motion keeps a hull valid")
     }
+}
+
+/// Up to `count` indices of `candidates` chosen by farthest-point sampling, starting from the
+/// already chosen `seed` (or from the first candidate). Deterministic.
+fn farthest_points(pts: &[P3], candidates: &[usize], seed: &[usize], count: usize) -> Vec<usize> {
+    let mut out = Vec::with_capacity(count);
+    if candidates.is_empty() || count == 0 {
+        return out;
+    }
+    let mut dist: Vec<f64> = candidates
+        .iter()
+        .map(|&i| {
+            seed.iter()
+                .map(|&s| (pts[i] - pts[s]).norm_squared())
+                .fold(f64::INFINITY, f64::min)
+        })
+        .collect();
+    if seed.is_empty() {
+        out.push(candidates[0]);
+        for (k, &i) in candidates.iter().enumerate() {
+            dist[k] = (pts[i] - pts[candidates[0]]).norm_squared();
+        }
+    }
+    while out.len() < count {
+        let (k, &d) = dist
+            .iter()
+            .enumerate()
+            .max_by(|a, b| a.1.total_cmp(b.1).then(b.0.cmp(&a.0)))
+            .unwrap();
+        if d <= 0.0 {
+            break;
+        }
+        let j = candidates[k];
+        out.push(j);
+        for (m, &i) in candidates.iter().enumerate() {
+            dist[m] = dist[m].min((pts[i] - pts[j]).norm_squared());
+        }
+    }
+    out
 }
 
 #[cfg(test)]
@@ -154,6 +241,34 @@ mod tests {
             .map(|i| P3::new(i as f64, (i * i) as f64, 0.0))
             .collect();
         assert!(Hull::from_points(&pts).is_none());
+    }
+
+    #[test]
+    fn simplification_keeps_the_flat_face_an_object_rests_on() {
+        // A fruit cut flat at the bottom: the simplified hull must still stand on that flat spot,
+        // with its support polygon around the centre of mass.
+        let m = shapes::fruit(0.04, 0.036, 0.02, 32, 16);
+        let zmin = m.vertices.iter().map(|v| v.z).fold(f64::INFINITY, f64::min);
+        let h = Hull::from_points(&m.vertices)
+            .unwrap()
+            .simplified(64)
+            .unwrap();
+        assert!(h.vertices.len() <= 64);
+        let bottom: Vec<&P3> = h.vertices.iter().filter(|v| v.z < zmin + 1e-9).collect();
+        assert!(
+            bottom.len() >= 6,
+            "flat face kept: {} vertices",
+            bottom.len()
+        );
+        let com = crate::inertia::of_closed_mesh(&m, 1000.0).com;
+        let r = bottom
+            .iter()
+            .map(|v| ((v.x - com.x).powi(2) + (v.y - com.y).powi(2)).sqrt())
+            .fold(f64::INFINITY, f64::min);
+        assert!(
+            r > 0.015,
+            "support polygon reaches {r} m from the centre of mass"
+        );
     }
 
     #[test]

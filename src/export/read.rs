@@ -1,6 +1,7 @@
 //! Reading an export folder back: the bodies exactly as written (visual OBJ in body frames,
 //! collision hull OBJs, inertials and initial poses from `scene.json`), so `validate OUT` checks
-//! what a simulator will load, not a recomputation.
+//! what a simulator will load, not a recomputation. Static checks run at the recorded composed
+//! pose; the settle starts from the initial (shipped) pose.
 
 use crate::body::{Assembly, Body};
 use crate::decompose::Hull;
@@ -79,13 +80,11 @@ pub fn load(path: &Path, limits: &Limits) -> Result<Assembly> {
         };
         inertial.check().map_err(err)?;
         let iso = |s: &Similarity| Isometry3::from_parts(s.translation.into(), s.rotation);
-        // The shipped state is what is validated: the initial pose is the composed pose here.
-        let _ = composed;
         bodies.push(Body {
             name: o.name.clone(),
             label: o.label.clone(),
             pose: iso(&pose),
-            composed_pose: iso(&pose),
+            composed_pose: iso(&composed),
             mesh_to_body: Similarity::identity(),
             closed: geometry.is_closed(),
             visual,

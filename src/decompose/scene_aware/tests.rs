@@ -131,7 +131,13 @@ fn bowl_keeps_its_cavity_and_follows_the_surface() {
 
 #[test]
 fn convex_shortcut_for_sphere_and_box() {
-    let o = opts();
+    // The shortcut hull is built from mesh vertices and inflated by at most a quarter of the
+    // tolerance (so it cannot close a gap left by the composition). A 64-vertex hull of a fine
+    // sphere is then 1.2 % of the diagonal off at the 95th percentile (measured), over the 1 %
+    // tolerance, so the sphere takes the shortcut with a 128-vertex budget; at 64 it gets patch
+    // hulls instead.
+    let mut o = opts();
+    o.max_vertices = 128;
     let sphere = shapes::uv_sphere(0.05, 24, 48);
     let cube = shapes::cuboid(V3::new(0.04, 0.06, 0.03));
     let (hulls, rep) = decompose_scene(&[&sphere], &o);
@@ -143,7 +149,8 @@ fn convex_shortcut_for_sphere_and_box() {
         "{} vs {v}",
         hulls[0][0].volume
     );
-    assert!(hulls[0][0].vertices.len() <= 64);
+    assert!(hulls[0][0].vertices.len() <= 128);
+    let o = opts();
     let (hulls, rep) = decompose_scene(&[&cube], &o);
     assert!(rep.objects[0].convex_shortcut);
     assert_eq!(hulls[0].len(), 1);
@@ -199,8 +206,9 @@ fn pen_in_mug_hulls_apart() {
 
 #[test]
 fn ball_in_bowl_hulls_apart() {
-    let rep = check_scene(&fixture("ball_bowl"));
-    assert!(rep.objects[1].convex_shortcut);
+    // The ball (960 triangles) is too round for a single 64-vertex hull within 1 % (see
+    // convex_shortcut_for_sphere_and_box); check_scene asserts its hulls stay off the bowl.
+    check_scene(&fixture("ball_bowl"));
 }
 
 #[test]
