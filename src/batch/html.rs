@@ -76,7 +76,6 @@ function fmt(v, kind) {
   if (v === null || v === undefined) return "";
   if (kind === "mm") return (v * 1000).toPrecision(3);
   if (kind === "num" && typeof v === "number" && !Number.isInteger(v)) return v.toPrecision(3);
-  if (kind === "list") return v.join(" ");
   return String(v);
 }
 function value(r, key) {
@@ -106,7 +105,7 @@ function render() {
         [i ? " " : "", el("a", { href: base + f, textContent: f.replace(/\.\w+$/, "") })]
       ).concat([" ", el("a", { href: base, textContent: "folder" })]));
     }
-    const td = el("td", { textContent: fmt(value(r, key), kind) });
+    const td = el("td", { textContent: kind === "list" ? r[key].join(" ") : fmt(value(r, key), kind) });
     if (kind === "num" || kind === "mm") td.className = "num";
     if (key === "verdict") td.className = r.verdict;
     if (kind === "msg") td.className = "msg";
