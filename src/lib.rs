@@ -6,6 +6,7 @@
 //! [`prepare`] (metres, Z-up, on the ground) → [`decompose`] (convex hulls) → [`inertia`] →
 //! [`export`] (MJCF, URDF) → [`metrics`] and [`physics`] (validation).
 
+pub mod batch;
 pub mod body;
 pub mod decompose;
 pub mod error;

@@ -25,6 +25,9 @@ enum Command {
     Export(ExportArgs),
     /// Check a scene or an export folder: interpenetration metrics and a Rapier settle test.
     Validate(ValidateArgs),
+    /// Convert a whole dataset: every sample folder and scene.json under ROOT, in parallel,
+    /// resumable, shardable; writes OUT/summary.json, summary.csv and index.html.
+    Batch(BatchArgs),
 }
 
 #[derive(Args, Clone)]
@@ -140,6 +143,62 @@ struct ExportArgs {
     junit: Option<PathBuf>,
 }
 
+#[derive(Args)]
+struct BatchArgs {
+    /// Dataset root (e.g. outputs/). With --merge-reports: shard summaries or folders holding
+    /// them (default: OUT).
+    #[arg(value_name = "ROOT")]
+    inputs: Vec<PathBuf>,
+    /// Output folder: one folder per scene, mirroring ROOT, plus the summaries.
+    #[arg(short, long)]
+    out: PathBuf,
+    /// Only scenes whose path relative to ROOT matches one of these globs (e.g. 'food/**').
+    #[arg(long, value_name = "GLOB")]
+    include: Vec<String>,
+    /// Skip scenes whose relative path matches one of these globs.
+    #[arg(long, value_name = "GLOB")]
+    exclude: Vec<String>,
+    /// Scenes converted at once (default: all cores).
+    #[arg(short, long, value_name = "N")]
+    jobs: Option<usize>,
+    /// Process only shard I of N (1-based; by a hash of each scene's relative path).
+    #[arg(long, value_name = "I/N")]
+    shard: Option<interact3d::batch::Shard>,
+    /// Continue an earlier run in OUT (required to exist); finished scenes are reused.
+    #[arg(long)]
+    resume: bool,
+    /// Convert every scene even if its output is current; accept an OUT that is not a batch.
+    #[arg(long)]
+    force: bool,
+    /// Combine shard summaries (summary.shard-I-of-N.json) into OUT/summary.json, .csv, index.html.
+    #[arg(long, conflicts_with_all = ["shard", "resume", "force", "include", "exclude", "list"])]
+    merge_reports: bool,
+    /// Print the selected scenes (relative paths) on stdout and stop.
+    #[arg(long)]
+    list: bool,
+    /// Progress on stderr: a bar on a terminal, else one line per scene.
+    #[arg(long, value_enum, default_value_t = ProgressArg::Auto)]
+    progress: ProgressArg,
+    #[command(flatten)]
+    build: BuildArgs,
+    /// Folder of templates overriding the built-in ones.
+    #[arg(long)]
+    templates: Option<PathBuf>,
+    /// Start bodies at the composed pose even when validation passes.
+    #[arg(long)]
+    keep_composed_pose: bool,
+    #[command(flatten)]
+    check: CheckArgs,
+}
+
+#[derive(Clone, Copy, clap::ValueEnum)]
+enum ProgressArg {
+    Auto,
+    Bar,
+    Lines,
+    Quiet,
+}
+
 fn parse_size(s: &str) -> Result<(String, f64), String> {
     let (name, v) = s.split_once('=').ok_or("expected NAME=METRES")?;
     let v: f64 = v.parse().map_err(|_| format!("{v:?} is not a number"))?;
@@ -227,6 +286,7 @@ fn run(cli: Cli) -> Result<ExitCode, Error> {
                 None => Ok(ExitCode::SUCCESS),
             }
         }
+        Command::Batch(a) => batch(a),
         Command::Validate(a) => {
             let t = std::time::Instant::now();
             let (assembly, v) = interact3d::pipeline::validate_path(
@@ -259,4 +319,69 @@ fn run(cli: Cli) -> Result<ExitCode, Error> {
             })
         }
     }
+}
+
+fn batch(a: BatchArgs) -> Result<ExitCode, Error> {
+    use interact3d::batch;
+    if a.merge_reports {
+        let m = batch::merge_reports(&a.out, &a.inputs)?;
+        for w in &m.warnings {
+            eprintln!("warning: {w}");
+        }
+        eprintln!(
+            "merged {} summaries: {} scenes: {} pass, {} fail, {} error -> {}",
+            m.summary.run.merged_from.len(),
+            m.summary.counts.scenes,
+            m.summary.counts.pass,
+            m.summary.counts.fail,
+            m.summary.counts.error,
+            a.out.join("summary.json").display()
+        );
+        return Ok(ExitCode::from(if m.incomplete {
+            2
+        } else {
+            m.summary.exit_code
+        }));
+    }
+    let [root] = a.inputs.as_slice() else {
+        return Err(Error::Usage(
+            "batch takes one ROOT folder (several only with --merge-reports)".into(),
+        ));
+    };
+    let job = interact3d::pipeline::ExportJob {
+        build: a.build.options(),
+        export: interact3d::export::ExportOptions {
+            templates: a.templates,
+            force: false,
+        },
+        validate: Some(a.check.options()),
+        keep_composed_pose: a.keep_composed_pose,
+        ..Default::default()
+    };
+    let mut opts = batch::BatchOptions::new(root, &a.out, job);
+    opts.include = a.include;
+    opts.exclude = a.exclude;
+    opts.jobs = a.jobs;
+    opts.shard = a.shard;
+    opts.resume = a.resume;
+    opts.force = a.force;
+    opts.progress = match a.progress {
+        ProgressArg::Auto => batch::Progress::Auto,
+        ProgressArg::Bar => batch::Progress::Bar,
+        ProgressArg::Lines => batch::Progress::Lines,
+        ProgressArg::Quiet => batch::Progress::Quiet,
+    };
+    if a.list {
+        for e in batch::scenes(&opts)? {
+            println!("{}", e.rel);
+        }
+        return Ok(ExitCode::SUCCESS);
+    }
+    let s = batch::run(&opts)?;
+    eprintln!("{}", batch::counts_line(&s));
+    eprintln!(
+        "summary: {}",
+        a.out.join(batch::Summary::file_name(s.shard)).display()
+    );
+    Ok(ExitCode::from(s.exit_code))
 }
