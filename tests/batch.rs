@@ -87,7 +87,7 @@ fn converts_good_scenes_reports_broken_ones_and_a_rerun_reuses_them() {
     assert!(
         fail["failed_checks"]
             .to_string()
-            .contains("static_penetration"),
+            .contains("visual_penetration"),
         "{fail}"
     );
     // CSV: header + one line per scene; HTML: self-contained.
