@@ -77,7 +77,7 @@ fn main() {
     println!("| step (1 core) | time | result |");
     println!("|---|---:|---|");
     println!(
-        "| load + prepare + V-HACD + inertia | {:.0} ms | |",
+        "| load + prepare + decompose (default engine) + inertia | {:.0} ms | |",
         t_build * 1e3
     );
     println!(
