@@ -10,6 +10,12 @@
 //!    δ ≤ tolerance that gives back the full hull's volume, is used alone when its surface
 //!    deviates from the mesh by at most the tolerance (p95 of sampled one-sided distances) and
 //!    by at most 3× the tolerance anywhere, so a cavity or an opening is never closed by it.
+//!    A convex object too round for one hull within `max_vertices` (a ball, a fruit scan) is
+//!    split *exactly* instead: its hull's faces are grouped into patches of fewer than
+//!    `max_vertices` vertices and each patch is coned to the centroid ([`geom::cone_pieces`]),
+//!    so the pieces' union is the hull itself and the facet it rests on is kept. Surface-patch
+//!    hulls (step 2) instead leave seams whose rest facets differ from engine to engine: a
+//!    ball in a bowl settled 2.5 mm apart in Rapier and MuJoCo with them.
 //! 2. **Wall-segment / surface-patch hulls** otherwise. Change from the suggested design: a
 //!    pure surface patch on a thin wall bulges *through* the wall into the cavity (its chord),
 //!    and covering the outer and inner sides separately halves the budget per side. So each
@@ -62,7 +68,7 @@ use std::sync::Mutex;
 /// Engine name, recorded in reports and in the cache key.
 pub const NAME: &str = "scene_aware";
 /// Bumped whenever the output for the same input changes (invalidates the cache).
-pub const VERSION: u32 = 1;
+pub const VERSION: u32 = 2;
 
 /// What happened to one object.
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
@@ -385,8 +391,10 @@ fn build_part(
     })
 }
 
-/// The convex shortcut: one hull if the object is convex enough.
-fn shortcut(s: &Surface, p: &Params, opts: &DecomposeOptions) -> Option<Part> {
+/// The convex shortcut: one hull if the object is convex enough; else, for a convex object
+/// too round for one hull within the vertex limit, exact cone pieces of its hull (at most
+/// `budget`), see [`geom::cone_pieces`].
+fn shortcut(s: &Surface, p: &Params, opts: &DecomposeOptions, budget: usize) -> Option<Vec<Part>> {
     let full = Hull::from_points(&s.mesh.vertices)?;
     // Two simplifications, both using only mesh vertices (so the hull never leaves the mesh and
     // cannot close a gap the composition left: fruits 1 mm apart pushed each other away in MuJoCo
@@ -428,14 +436,46 @@ fn shortcut(s: &Surface, p: &Params, opts: &DecomposeOptions) -> Option<Part> {
     for h in candidates.into_iter().flatten().map(inflate) {
         let (p95, max) = deviation(&h)?;
         if p95 <= p.tol && max <= 3.0 * p.tol {
-            return Some(Part {
+            return Some(vec![Part {
                 tris: Vec::new(),
                 outer: h.vertices.clone(),
                 hull: h,
                 normal: V3::zeros(),
                 cuts: Vec::new(),
                 dev: max,
-            });
+            }]);
+        }
+    }
+    // Convex but too round for one hull: cone pieces of the full hull, or of a greedy
+    // reduction of it (a 16k-triangle scan has thousands of hull vertices), whose union is
+    // that hull exactly. Pieces overlapping a neighbour are cut like any other part.
+    // Only for convex objects: when the full hull already deviates, no reduction of it helps.
+    let (p95, max) = deviation(&full)?;
+    if !(p95 <= p.tol && max <= 3.0 * p.tol) {
+        return None;
+    }
+    let per_piece = opts.max_vertices.saturating_sub(1) / 2;
+    let reduce = || greedy_hull(&full, (budget * per_piece).max(4));
+    for h in [Some(full.clone()), None] {
+        let Some(h) = h.or_else(reduce) else { continue };
+        let (p95, max) = deviation(&h)?;
+        if !(p95 <= p.tol && max <= 3.0 * p.tol) {
+            continue;
+        }
+        if let Some(pieces) = geom::cone_pieces(&h, opts.max_vertices, budget) {
+            return Some(
+                pieces
+                    .into_iter()
+                    .map(|(hull, outer, normal)| Part {
+                        tris: Vec::new(),
+                        hull,
+                        outer,
+                        normal,
+                        cuts: Vec::new(),
+                        dev: max,
+                    })
+                    .collect(),
+            );
         }
     }
     None
@@ -540,10 +580,10 @@ fn decompose_alone(mesh: &Mesh, opts: &DecomposeOptions, budget: usize) -> Obj {
     };
     let p = Params::new(s, opts);
     let mut report = ObjectReport::default();
-    if let Some(part) = shortcut(s, &p, opts) {
+    if let Some(parts) = shortcut(s, &p, opts, budget) {
         report.convex_shortcut = true;
         return Obj {
-            parts: vec![part],
+            parts,
             feat: None,
             surf,
             params: Some(p),
@@ -600,6 +640,76 @@ fn vertex_depth(a: &Surface, b: &Surface) -> f64 {
         .reduce(|| 0.0, f64::max)
 }
 
+/// Largest deviation (fraction of the tolerance) allowed of a patch hull that a neighbour
+/// could rest on.
+const CONTACT_DEV: f64 = 0.1;
+
+/// Refine where the neighbours are, before any cut: a patch hull whose bulge (its chord over a
+/// concave side, up to the tolerance) could reach a neighbour's hull is split, worst first, while
+/// the object's budget lasts, until its deviation is below `CONTACT_DEV` of the tolerance. A
+/// ball on a bowl's flat floor otherwise rests on the chords of the two patches that span the
+/// floor and the rising wall: a groove 0.1–0.3 mm above the floor, tilted 1–2°, in which each
+/// engine finds a different rest (Rapier and MuJoCo 2.5 mm apart). Pairs whose meshes
+/// interpenetrate are left to the cuts.
+fn contact_splits(
+    objs: &mut [Obj],
+    pairs: &[(usize, usize)],
+    mesh_pen: &[Vec<f64>],
+    opts: &DecomposeOptions,
+) {
+    for _ in 0..opts.max_hulls {
+        let mut worst: Option<(f64, usize, usize)> = None;
+        for &(a, b) in pairs {
+            if mesh_pen[a][b] > 0.0 {
+                continue;
+            }
+            for (o, other) in [(a, b), (b, a)] {
+                let obj = &objs[o];
+                let (Some(p), true) = (&obj.params, obj.parts.len() < opts.max_hulls) else {
+                    continue;
+                };
+                for (k, part) in obj.parts.iter().enumerate() {
+                    if part.tris.len() < 4
+                        || part.dev <= CONTACT_DEV * p.tol
+                        || worst.is_some_and(|w| (w.0, w.1, w.2) >= (part.dev, o, k))
+                    {
+                        continue;
+                    }
+                    let reach = opts.clearance + part.dev;
+                    let Some(hp) = polyhedron(&part.hull) else {
+                        continue;
+                    };
+                    let near = objs[other].parts.iter().any(|q| {
+                        part.hull.aabb.intersects(&q.hull.aabb, reach)
+                            && polyhedron(&q.hull).is_some_and(|hq| geom::distance(&hp, &hq) < reach)
+                    });
+                    if near {
+                        worst = Some((part.dev, o, k));
+                    }
+                }
+            }
+        }
+        let Some((_, o, k)) = worst else { return };
+        let obj = &objs[o];
+        let (Some(s), Some(p), Some(f)) = (&obj.surf, &obj.params, &obj.feat) else {
+            return;
+        };
+        match split(s, f, p, opts, &obj.parts[k]) {
+            Some((x, y)) => {
+                let obj = &mut objs[o];
+                obj.parts[k] = x;
+                obj.parts.push(y);
+                obj.report.neighbour_splits += 1;
+            }
+            // Unsplittable: mark it done by pretending it is within the contact tolerance.
+            None => {
+                let t = CONTACT_DEV * p.tol;
+                objs[o].parts[k].dev = t;
+            }
+        }
+    }
+}
+
 /// A conflict: hull `i` of object `a` and hull `j` of object `b` (`a < b`) closer than allowed.
 #[derive(Clone, Copy, Debug)]
 struct Conflict {
@@ -654,6 +764,7 @@ pub fn decompose_scene(
             }
         }
     }
+    contact_splits(&mut objs, &pairs, &mesh_pen, opts);
     let rounds = refine(&mut objs, &pairs, &mesh_pen, opts);
     // Final limits and report.
     let mut hulls: Vec<Vec<Hull>> = Vec::with_capacity(n);

@@ -4,7 +4,7 @@ usage: check_mujoco.py OUT_DIR [--seconds S] [--key NAME]
 
 Reports: body and geom counts per body, masses and inertias as MuJoCo compiled them, the deepest
 initial contact between different bodies, per-body motion after S seconds (position change in m,
-rotation angle in degrees), whether the state stayed finite, and which free bodies moved more
+rotation angle in degrees) and final body positions, whether the state stayed finite, and which free bodies moved more
 than 1 mm / 1 degree. Also loads every <object>.xml alone and all of them through <include>.
 """
 import json
@@ -71,7 +71,9 @@ def main():
             finite = False
             break
     motion = {}
+    final_pos = {}
     for b in range(1, model.nbody):
+        final_pos[model.body(b).name] = [float(x) for x in data.xpos[b]]
         name = model.body(b).name
         p0, q0 = start[name]
         motion[name] = {
@@ -106,6 +108,7 @@ def main():
             "initial_penetration_pair": deepest_pair,
             "finite": finite,
             "motion": motion,
+            "final_pos": final_pos,
             "objects": objects_ok,
             "include_nbody": include_nbody,
         },

@@ -331,3 +331,90 @@ pub fn hull_vertex_normals(h: &Hull) -> Vec<V3> {
     }
     n
 }
+
+/// Exact convex pieces of a convex hull with too many vertices for one engine hull.
+///
+/// The hull's faces are grouped into edge-connected patches of at most `max_vertices − 1`
+/// vertices (breadth-first region growing from the lowest unassigned face, so patches are
+/// compact and the result deterministic), and each patch becomes the cone from the hull's
+/// vertex centroid over it: `conv(patch ∪ {c})`. Every piece lies inside the hull (convexity)
+/// and every hull face lies on the boundary of one piece, so the union of the pieces *is* the
+/// hull: no deviation, no bulge, and the facet an object rests on survives. Pieces overlap
+/// where a patch's outline is not convex as seen from `c`; within one body that is harmless
+/// (no self-collision; inertia comes from the mesh). Returns each piece with its
+/// patch's vertices (its part of the outer surface) and the patch's mean outward normal, or
+/// `None` when more than `max_pieces` pieces would be needed or a piece is degenerate.
+pub fn cone_pieces(
+    full: &Hull,
+    max_vertices: usize,
+    max_pieces: usize,
+) -> Option<Vec<(Hull, Vec<P3>, V3)>> {
+    let cap = max_vertices.checked_sub(1).filter(|&c| c >= 3)?;
+    let nt = full.triangles.len();
+    if nt < 4 {
+        return None;
+    }
+    // Face adjacency through shared edges (sorted edge list: deterministic, no hashing).
+    let mut edges: Vec<([u32; 2], usize)> = Vec::with_capacity(3 * nt);
+    for (f, t) in full.triangles.iter().enumerate() {
+        for k in 0..3 {
+            let (a, b) = (t[k], t[(k + 1) % 3]);
+            edges.push(([a.min(b), a.max(b)], f));
+        }
+    }
+    edges.sort_unstable();
+    let mut adj: Vec<Vec<usize>> = vec![Vec::new(); nt];
+    for w in edges.windows(2) {
+        if w[0].0 == w[1].0 {
+            adj[w[0].1].push(w[1].1);
+            adj[w[1].1].push(w[0].1);
+        }
+    }
+    let c = P3::from(full.vertices.iter().map(|v| v.coords).sum::<V3>() / full.vertices.len() as f64);
+    let mut assigned = vec![false; nt];
+    let mut pieces = Vec::new();
+    for seed in 0..nt {
+        if assigned[seed] {
+            continue;
+        }
+        if pieces.len() == max_pieces {
+            return None;
+        }
+        let mut verts: Vec<u32> = Vec::with_capacity(cap);
+        let mut faces = Vec::new();
+        let mut queue = std::collections::VecDeque::from([seed]);
+        let mut queued = vec![false; nt];
+        queued[seed] = true;
+        while let Some(f) = queue.pop_front() {
+            let new: Vec<u32> = full.triangles[f]
+                .iter()
+                .copied()
+                .filter(|v| !verts.contains(v))
+                .collect();
+            if verts.len() + new.len() > cap {
+                continue;
+            }
+            verts.extend(new);
+            assigned[f] = true;
+            faces.push(f);
+            for &g in &adj[f] {
+                if !assigned[g] && !queued[g] {
+                    queued[g] = true;
+                    queue.push_back(g);
+                }
+            }
+        }
+        let mut normal = V3::zeros();
+        for &f in &faces {
+            let [a, b, d] = full.triangles[f].map(|i| full.vertices[i as usize]);
+            normal += (b - a).cross(&(d - a));
+        }
+        let normal = normal.try_normalize(1e-300).unwrap_or_else(V3::zeros);
+        let outer: Vec<P3> = verts.iter().map(|&i| full.vertices[i as usize]).collect();
+        let mut pts = outer.clone();
+        pts.push(c);
+        let piece = Hull::from_points(&pts).filter(|h| h.vertices.len() <= max_vertices)?;
+        pieces.push((piece, outer, normal));
+    }
+    Some(pieces)
+}

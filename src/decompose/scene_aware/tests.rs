@@ -270,3 +270,47 @@ fn deterministic_and_cached() {
     assert!(warm * 5 < cold, "cache {warm:?} vs {cold:?}");
     assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1);
 }
+
+#[test]
+fn cone_pieces_are_exactly_the_hull() {
+    // A 32x16 UV sphere: 32 x 15 ring vertices + 2 poles = 482 hull vertices, far over 64.
+    let sphere = shapes::uv_sphere(0.033, 16, 32);
+    let full = Hull::from_points(&sphere.vertices).unwrap();
+    assert_eq!(full.vertices.len(), 482);
+    let pieces = geom::cone_pieces(&full, 64, 32).unwrap();
+    assert!(pieces.len() >= 8 && pieces.len() <= 16, "{}", pieces.len());
+    // The union is the hull: every point of the hull is in a piece (pieces may overlap where
+    // a patch outline is not convex as seen from the centre, so volumes do not simply add up).
+    let sum: f64 = pieces.iter().map(|p| p.0.volume).sum();
+    assert!(sum >= full.volume * (1.0 - 1e-12));
+    let mut rng = geom::SplitMix(7);
+    let mut inside = 0;
+    for _ in 0..20_000 {
+        let q = P3::new(
+            (rng.next_f64() - 0.5) * 0.068,
+            (rng.next_f64() - 0.5) * 0.068,
+            (rng.next_f64() - 0.5) * 0.068,
+        );
+        if full.contains(&q) {
+            inside += 1;
+            assert!(pieces.iter().any(|(h, _, _)| h.contains(&q)), "{q:?} uncovered");
+        }
+    }
+    assert!(inside > 8_000, "{inside}");
+    for (h, outer, normal) in &pieces {
+        assert!(h.vertices.len() <= 64);
+        assert!(outer.len() <= 63 && normal.norm() > 0.99);
+        // Inside the hull.
+        assert!(h.vertices.iter().all(|v| full.plane_distance(v) <= 1e-12));
+    }
+    // Every hull face lies on the boundary of some piece (its centroid is on a piece's face
+    // plane and inside the piece): together the pieces cover the whole surface.
+    for t in &full.triangles {
+        let c = P3::from(t.iter().map(|&i| full.vertices[i as usize].coords).sum::<V3>() / 3.0);
+        assert!(pieces
+            .iter()
+            .any(|(h, _, _)| h.plane_distance(&c).abs() <= 1e-12));
+    }
+    // Too few pieces allowed: refused.
+    assert!(geom::cone_pieces(&full, 64, 3).is_none());
+}
