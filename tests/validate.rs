@@ -287,7 +287,11 @@ fn ball_rests_at_the_bottom_of_the_bowl_in_mujoco_after_2_s() {
         "check_mujoco.py",
         &[dir.to_str().unwrap(), "--seconds", "2"],
     );
-    assert!(mj["initial_penetration"].as_f64().unwrap() <= 0.1 * MM, "{}", mj["initial_penetration"]);
+    assert!(
+        mj["initial_penetration"].as_f64().unwrap() <= 0.1 * MM,
+        "{}",
+        mj["initial_penetration"]
+    );
     let p = |n: &str| -> Vec<f64> {
         mj["final_pos"][n]
             .as_array()
@@ -302,5 +306,9 @@ fn ball_rests_at_the_bottom_of_the_bowl_in_mujoco_after_2_s() {
         .map(|k| (ball[k] - expected[k]).powi(2))
         .sum::<f64>()
         .sqrt();
-    assert!(err <= MM, "ball at {ball:?}, expected {expected:?}: {:.3} mm off", err / MM);
+    assert!(
+        err <= MM,
+        "ball at {ball:?}, expected {expected:?}: {:.3} mm off",
+        err / MM
+    );
 }

@@ -681,7 +681,8 @@ fn contact_splits(
                     };
                     let near = objs[other].parts.iter().any(|q| {
                         part.hull.aabb.intersects(&q.hull.aabb, reach)
-                            && polyhedron(&q.hull).is_some_and(|hq| geom::distance(&hp, &hq) < reach)
+                            && polyhedron(&q.hull)
+                                .is_some_and(|hq| geom::distance(&hp, &hq) < reach)
                     });
                     if near {
                         worst = Some((part.dev, o, k));

@@ -370,7 +370,8 @@ pub fn cone_pieces(
             adj[w[1].1].push(w[0].1);
         }
     }
-    let c = P3::from(full.vertices.iter().map(|v| v.coords).sum::<V3>() / full.vertices.len() as f64);
+    let c =
+        P3::from(full.vertices.iter().map(|v| v.coords).sum::<V3>() / full.vertices.len() as f64);
     let mut assigned = vec![false; nt];
     let mut pieces = Vec::new();
     for seed in 0..nt {

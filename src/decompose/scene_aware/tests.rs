@@ -293,7 +293,10 @@ fn cone_pieces_are_exactly_the_hull() {
         );
         if full.contains(&q) {
             inside += 1;
-            assert!(pieces.iter().any(|(h, _, _)| h.contains(&q)), "{q:?} uncovered");
+            assert!(
+                pieces.iter().any(|(h, _, _)| h.contains(&q)),
+                "{q:?} uncovered"
+            );
         }
     }
     assert!(inside > 8_000, "{inside}");
@@ -306,7 +309,12 @@ fn cone_pieces_are_exactly_the_hull() {
     // Every hull face lies on the boundary of some piece (its centroid is on a piece's face
     // plane and inside the piece): together the pieces cover the whole surface.
     for t in &full.triangles {
-        let c = P3::from(t.iter().map(|&i| full.vertices[i as usize].coords).sum::<V3>() / 3.0);
+        let c = P3::from(
+            t.iter()
+                .map(|&i| full.vertices[i as usize].coords)
+                .sum::<V3>()
+                / 3.0,
+        );
         assert!(pieces
             .iter()
             .any(|(h, _, _)| h.plane_distance(&c).abs() <= 1e-12));
