@@ -95,7 +95,7 @@ pub fn surface_distances(s: &Surface, hulls: &[Hull], n: usize) -> Vec<f64> {
                     !hulls
                         .iter()
                         .enumerate()
-                        .any(|(j, g)| j != i && g.plane_distance(p) < -eps)
+                        .any(|(j, g)| j != i && g.plane_distance(p) <= eps)
                 })
                 .map(|p| s.distance(&p) / s.diag)
                 .collect::<Vec<_>>()
