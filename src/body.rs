@@ -118,6 +118,18 @@ pub fn assemble(
         let density = o.physical.density.unwrap_or(DEFAULT_DENSITY);
         let mut warnings = o.warnings.clone();
         warnings.extend(notes.get(k).into_iter().flatten().cloned());
+        let smallest = o.geometry.aabb().map(|b| b.extents().min()).unwrap_or(0.0);
+        if hulls.is_empty() && smallest > 0.0 && smallest < dopts.min_thickness {
+            return Err(Error::input(
+                source,
+                format!(
+                    "object {} is too small or too thin to simulate: its smallest extent is {smallest:.3e} m, \
+                     under the {:.1e} m minimum collision hull thickness (MuJoCo refuses such meshes: \
+                     \"mesh volume is too small\"); check the units or scale the scene with --size",
+                    o.name, dopts.min_thickness
+                ),
+            ));
+        }
         if hulls.is_empty() {
             return Err(Error::input(
                 source,

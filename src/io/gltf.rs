@@ -38,6 +38,18 @@ pub fn load(path: &Path, limits: &Limits) -> Result<VisualMesh> {
 /// `root` is the folder no URI may leave.
 pub fn load_bytes(path: &Path, bytes: &[u8], root: &Path, limits: &Limits) -> Result<VisualMesh> {
     let err = |m: String| Error::input(path, m);
+    let is_glb_name = path
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("glb"));
+    if bytes.starts_with(b"glTF") {
+        check_glb_container(bytes).map_err(err)?;
+    } else if is_glb_name {
+        let head = &bytes[..bytes.len().min(4)];
+        return Err(err(format!(
+            "not a GLB file: it starts with {:?}, not the magic \"glTF\"",
+            String::from_utf8_lossy(head)
+        )));
+    }
     // The JSON is checked for extensions before the gltf crate validates (it rejects Draco with
     // a less helpful message).
     let gltf = gltf::Gltf::from_slice_without_validation(bytes).map_err(|e| err(describe(e)))?;
@@ -91,6 +103,9 @@ pub fn load_bytes(path: &Path, bytes: &[u8], root: &Path, limits: &Limits) -> Re
         }
     }
     let mut visited = 0usize;
+    // Triangles and vertices counted from the accessors before anything is read: a small file
+    // that instances a mesh a million times cannot make us allocate gigabytes.
+    let mut budget = Budget::default();
     while let Some((node, parent)) = stack.pop() {
         visited += 1;
         if visited > 1_000_000 {
@@ -100,9 +115,16 @@ pub fn load_bytes(path: &Path, bytes: &[u8], root: &Path, limits: &Limits) -> Re
         let world = parent * local;
         if let Some(mesh) = node.mesh() {
             for prim in mesh.primitives() {
-                if let Some(part) =
-                    read_primitive(path, root, &prim, &buffers, &world, &mut textures, limits)?
-                {
+                if let Some(part) = read_primitive(
+                    path,
+                    root,
+                    &prim,
+                    &buffers,
+                    &world,
+                    &mut textures,
+                    &mut budget,
+                    limits,
+                )? {
                     parts.push(part);
                 }
             }
@@ -112,6 +134,80 @@ pub fn load_bytes(path: &Path, bytes: &[u8], root: &Path, limits: &Limits) -> Re
         }
     }
     Ok(VisualMesh { parts })
+}
+
+/// Check the GLB header and chunk table before the `gltf` crate reads them (it subtracts
+/// without checking and its messages are terse): version 2, declared length within the file,
+/// a JSON chunk first, every chunk inside the declared length.
+fn check_glb_container(bytes: &[u8]) -> std::result::Result<(), String> {
+    let n = bytes.len() as u64;
+    if n < 12 {
+        return Err(format!(
+            "truncated GLB: {n} bytes, shorter than the 12-byte header"
+        ));
+    }
+    let u32_at = |o: u64| -> u64 {
+        let o = o as usize;
+        u32::from_le_bytes([bytes[o], bytes[o + 1], bytes[o + 2], bytes[o + 3]]) as u64
+    };
+    let version = u32_at(4);
+    if version != 2 {
+        return Err(format!(
+            "unsupported GLB version {version} (only glTF 2.0 is read)"
+        ));
+    }
+    let length = u32_at(8);
+    if length > n {
+        return Err(format!(
+            "truncated GLB: the header declares {length} bytes but the file has {n}"
+        ));
+    }
+    if length < 20 {
+        return Err(format!(
+            "corrupt GLB: the header declares {length} bytes, too few for a JSON chunk"
+        ));
+    }
+    let mut offset = 12u64;
+    let mut k = 0;
+    while offset < length {
+        if offset + 8 > length {
+            return Err(format!(
+                "corrupt GLB: chunk {k} header at byte {offset} runs past the declared length {length}"
+            ));
+        }
+        let chunk_len = u32_at(offset);
+        let ty = &bytes[offset as usize + 4..offset as usize + 8];
+        let name = match ty {
+            b"JSON" => "JSON",
+            b"BIN\0" => "BIN",
+            _ => "unknown",
+        };
+        if k == 0 && name != "JSON" {
+            return Err("corrupt GLB: the first chunk is not the JSON chunk".into());
+        }
+        if k == 1 && name != "BIN" {
+            return Err(format!(
+                "corrupt GLB: the second chunk has type {:?}, not BIN",
+                String::from_utf8_lossy(ty)
+            ));
+        }
+        let left = length - offset - 8;
+        if chunk_len > left {
+            return Err(format!(
+                "corrupt GLB: chunk {k} ({name}) declares {chunk_len} bytes but only {left} remain (truncated or corrupt)"
+            ));
+        }
+        offset += 8 + chunk_len;
+        k += 1;
+    }
+    Ok(())
+}
+
+/// Triangles and vertices taken so far, over all primitive instances.
+#[derive(Default)]
+struct Budget {
+    triangles: usize,
+    vertices: usize,
 }
 
 fn describe(e: gltf::Error) -> String {
@@ -132,7 +228,10 @@ fn read_uri(path: &Path, root: &Path, uri: &str, limits: &Limits) -> Result<Vec<
             .split_once(";base64,")
             .ok_or_else(|| Error::input(path, "data: URI is not base64-encoded"))?;
         if data.len() as u64 / 4 * 3 > limits.max_file_bytes {
-            return Err(Error::input(path, "data: URI is over the file size limit"));
+            return Err(Error::input(
+                path,
+                "data: URI is over the file size limit (--max-file-bytes)",
+            ));
         }
         return base64::engine::general_purpose::STANDARD
             .decode(data.trim())
@@ -212,6 +311,7 @@ fn read_primitive(
     buffers: &[Vec<u8>],
     world: &Matrix4<f64>,
     textures: &mut BTreeMap<usize, Texture>,
+    budget: &mut Budget,
     limits: &Limits,
 ) -> Result<Option<VisualPart>> {
     let err = |m: String| Error::input(path, m);
@@ -221,6 +321,25 @@ fn read_primitive(
         Mode::Triangles | Mode::TriangleStrip | Mode::TriangleFan
     ) {
         return Ok(None); // points and lines carry no surface
+    }
+    let vertex_count = prim
+        .get(&gltf::Semantic::Positions)
+        .map(|a| a.count())
+        .unwrap_or(0);
+    let index_count = prim.indices().map(|a| a.count()).unwrap_or(vertex_count);
+    let tris = match mode {
+        Mode::Triangles => index_count / 3,
+        _ => index_count.saturating_sub(2),
+    };
+    budget.triangles = budget.triangles.saturating_add(tris);
+    budget.vertices = budget.vertices.saturating_add(vertex_count);
+    if budget.triangles > limits.max_triangles
+        || budget.vertices > limits.max_triangles.saturating_mul(3)
+    {
+        return Err(err(format!(
+            "mesh has more than {} triangles (or 3x as many vertices), over the limit (--max-triangles)",
+            limits.max_triangles
+        )));
     }
     let reader = prim.reader(|b| buffers.get(b.index()).map(|d| d.as_slice()));
     let positions: Vec<P3> = reader
@@ -323,8 +442,10 @@ fn read_image(
     let origin = format!("{}#image{}", path.display(), image.index());
     let bytes = match image.source() {
         gltf::image::Source::View { view, .. } => {
-            let buf = &buffers[view.buffer().index()];
-            let end = view.offset() + view.length();
+            let buf = buffers
+                .get(view.buffer().index())
+                .ok_or_else(|| Error::input(&origin, "image refers to a missing buffer"))?;
+            let end = view.offset().saturating_add(view.length());
             if end > buf.len() {
                 return Err(Error::input(
                     &origin,
