@@ -328,6 +328,38 @@ fn glb_declared_counts_of_gigabytes() {
 }
 
 #[test]
+fn glb_cyclic_node_hierarchy() {
+    let t = tempfile::tempdir().unwrap();
+    for (case, nodes, scene_nodes, problem) in [
+        (
+            "self",
+            json!([{"mesh": 0, "children": [0]}]),
+            json!([0]),
+            "node 0 has more than one parent or is its own child",
+        ),
+        (
+            "twice",
+            json!([{"mesh": 0, "children": [1, 1]}, {"mesh": 0}]),
+            json!([0]),
+            "node 1 has more than one parent",
+        ),
+        (
+            "pair",
+            json!([{"mesh": 0, "children": [1]}, {"children": [0]}]),
+            json!([0]),
+            "scene root node 0 is also a child of node 1",
+        ),
+    ] {
+        let b = edited_glb(false, |j, _| {
+            j["nodes"] = nodes;
+            j["scenes"] = json!([{"nodes": scene_nodes}]);
+        });
+        let d = sample(t.path(), case, &b);
+        rejects(&d, "object_a.glb", problem);
+    }
+}
+
+#[test]
 fn glb_buffer_uri_escaping_the_scene_folder() {
     let t = tempfile::tempdir().unwrap();
     let (_, bin) = split_glb(&box_glb(false));
@@ -722,9 +754,47 @@ fn non_manifold_mesh_warns_and_falls_back_to_the_hull_union() {
 #[test]
 fn tiny_object_is_refused_with_a_clear_message() {
     let t = tempfile::tempdir().unwrap();
-    // A 0.1 mm cube: hulls this thin are what MuJoCo refuses ("mesh volume is too small").
+    // A 0.1 mm cube: thinner than the thinnest collision hull kept.
     let d = obj_scene(t.path(), "tiny", &obj_text(&cuboid(1e-4, 1e-4, 1e-4)));
-    rejects(&d, "scene.json", "object box is too small");
+    rejects(
+        &d,
+        "scene.json",
+        "object box is too small or too thin to simulate: its smallest extent is 1.000e-4 m",
+    );
+    // A 0.4 mm cube has hulls, but MuJoCo refuses its inertia (eigenvalues under 1e-14).
+    let d = obj_scene(t.path(), "light", &obj_text(&cuboid(4e-4, 4e-4, 4e-4)));
+    rejects(
+        &d,
+        "scene.json",
+        "object box is too small or too light to simulate: mass 6.400e-8 kg",
+    );
+}
+
+/// Whether Python's `mujoco` package can be imported.
+fn have_mujoco() -> bool {
+    std::process::Command::new(python())
+        .args(["-c", "import mujoco"])
+        .output()
+        .map(|o| o.status.success())
+        .unwrap_or(false)
+}
+
+#[test]
+fn small_object_above_the_limits_loads_in_mujoco() {
+    let t = tempfile::tempdir().unwrap();
+    // 0.7 mm and 1 mm cubes: exported, and MuJoCo compiles and steps them.
+    for (case, s) in [("c07", 7e-4), ("c10", 1e-3)] {
+        let d = obj_scene(t.path(), case, &obj_text(&cuboid(s, s, s)));
+        let out = t.path().join(case).join("out");
+        export_ok(&d, &out);
+        if !have_mujoco() {
+            eprintln!("python mujoco not installed: MuJoCo check skipped");
+            continue;
+        }
+        let mj = python_json("check_mujoco.py", &[out.to_str().unwrap()]);
+        assert_eq!(mj["nbody"], 2, "{mj}");
+        assert_eq!(mj["finite"], true, "{mj}");
+    }
 }
 
 #[test]
@@ -1050,6 +1120,20 @@ fn free_text_from_inputs_is_escaped_in_xml() {
     let m = read_json(&out.join("scene.json"));
     assert_eq!(m["name"], evil);
     assert_eq!(m["objects"][0]["label"], evil);
+}
+
+#[test]
+fn hostile_mesh_file_names_are_sanitised() {
+    let t = tempfile::tempdir().unwrap();
+    let d = case_dir(t.path(), "file");
+    let mesh = d.join("a b\"<&>'x.obj");
+    fs::write(&mesh, box_obj()).unwrap();
+    let out = t.path().join("file/out");
+    export_ok(&mesh, &out);
+    let r = read_json(&out.join("report.json"));
+    assert_eq!(r["objects"][0]["name"], "a_b_____x");
+    assert!(out.join("a_b_____x.xml").is_file());
+    assert!(out.join("meshes/a_b_____x/visual.obj").is_file());
 }
 
 #[test]

@@ -94,10 +94,34 @@ pub fn load_bytes(path: &Path, bytes: &[u8], root: &Path, limits: &Limits) -> Re
         Some(s) => vec![s],
         None => doc.scenes().collect(),
     };
+    // The node hierarchy must be a forest (glTF 2.0, 5.25): one parent at most, scene roots
+    // without one. Checked up front, so the walk below visits each node once per scene and a
+    // cycle is an error, not a million visits.
+    let mut parent: Vec<Option<usize>> = vec![None; doc.nodes().len()];
+    for n in doc.nodes() {
+        for c in n.children() {
+            if c.index() == n.index() || parent[c.index()].replace(n.index()).is_some() {
+                return Err(err(format!(
+                    "node {} has more than one parent or is its own child: the node hierarchy must be a tree",
+                    c.index()
+                )));
+            }
+        }
+    }
+    for scene in &scenes {
+        for n in scene.nodes() {
+            if let Some(p) = parent[n.index()] {
+                return Err(err(format!(
+                    "scene root node {} is also a child of node {p}: the node hierarchy must be a tree",
+                    n.index()
+                )));
+            }
+        }
+    }
     let mut textures: BTreeMap<usize, Texture> = BTreeMap::new();
     let mut parts = Vec::new();
     let mut stack: Vec<(gltf::Node, Matrix4<f64>)> = Vec::new();
-    for scene in scenes {
+    for scene in &scenes {
         for node in scene.nodes() {
             stack.push((node, Matrix4::identity()));
         }
