@@ -377,6 +377,23 @@ fn glb_buffer_uri_escaping_the_scene_folder() {
         let d = sample(t.path(), case, &b);
         rejects(&d, "object_a.glb", problem);
     }
+    // Percent-encoded dots are decoded before the check; a `%` before a multi-byte character
+    // (which once split the character and panicked) is kept as it is.
+    for (case, uri, problem) in [
+        (
+            "pct",
+            "%2e%2e/%2E%2E/secret.bin",
+            "points outside the scene folder",
+        ),
+        ("utf8", "%a\u{e9}.bin", "cannot open"),
+    ] {
+        let b = edited_glb(false, |j, bin| {
+            j["buffers"][0]["uri"] = json!(uri);
+            bin.clear();
+        });
+        let d = sample(t.path(), case, &b);
+        rejects(&d, "object_a.glb", problem);
+    }
     // Through a symbolic link inside the folder that points out of it.
     let b = edited_glb(false, |j, bin| {
         j["buffers"][0]["uri"] = json!("link.bin");
@@ -498,6 +515,17 @@ fn obj_index_zero() {
     // Negative but reaching before the first vertex.
     let d = obj_scene(t.path(), "neg", &(box_obj() + "f -1 -2 -9\n"));
     rejects(&d, "box.obj", "face vertex index -9 out of range");
+    // The most negative 64-bit index (its negation overflowed).
+    let d = obj_scene(
+        t.path(),
+        "min",
+        &(box_obj() + "f 1 2 -9223372036854775808\n"),
+    );
+    rejects(
+        &d,
+        "box.obj",
+        "face vertex index -9223372036854775808 out of range",
+    );
 }
 
 #[test]

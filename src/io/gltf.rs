@@ -267,13 +267,16 @@ fn read_uri(path: &Path, root: &Path, uri: &str, limits: &Limits) -> Result<Vec<
 }
 
 fn percent_decode(s: &str) -> String {
+    // On bytes: a `%` followed by anything but two hex digits is kept as it is (slicing the
+    // `str` there could split a multi-byte character).
     let b = s.as_bytes();
+    let hex = |c: u8| (c as char).to_digit(16).map(|d| d as u8);
     let mut out = Vec::with_capacity(b.len());
     let mut i = 0;
     while i < b.len() {
         if b[i] == b'%' && i + 2 < b.len() {
-            if let Ok(v) = u8::from_str_radix(&s[i + 1..i + 3], 16) {
-                out.push(v);
+            if let (Some(h), Some(l)) = (hex(b[i + 1]), hex(b[i + 2])) {
+                out.push(h * 16 + l);
                 i += 3;
                 continue;
             }

@@ -157,7 +157,8 @@ fn check_indices(path: &Path, text: &str) -> Result<()> {
                                 format!("line {}: bad face index {field:?}", lineno + 1),
                             )
                         })?;
-                        let ok = (i > 0 && i <= count) || (i < 0 && -i <= count);
+                        // unsigned_abs: -i64::MIN would overflow.
+                        let ok = i != 0 && i.unsigned_abs() <= count as u64;
                         if !ok {
                             return Err(Error::input(
                                 path,
