@@ -1075,6 +1075,29 @@ fn mesh_paths_escaping_the_manifest_folder() {
 }
 
 #[test]
+fn export_folder_with_escaping_collision_paths() {
+    let t = tempfile::tempdir().unwrap();
+    fs::write(t.path().join("outside.obj"), box_obj()).unwrap();
+    let d = obj_scene(t.path(), "exp", &box_obj());
+    let out = t.path().join("exp/out");
+    export_ok(&d, &out);
+    let mut m = read_json(&out.join("scene.json"));
+    m["objects"][0]["collision"][0] = json!("../../../outside.obj");
+    fs::write(out.join("scene.json"), serde_json::to_vec(&m).unwrap()).unwrap();
+    let before = snapshot(&out);
+    let (code, stdout, stderr) = run(&["validate", out.to_str().unwrap()]);
+    assert_eq!(code, 2, "{stderr}");
+    assert!(stdout.is_empty());
+    let line = stderr.trim();
+    assert_eq!(line.lines().count(), 1, "{line}");
+    assert!(
+        line.contains("scene.json") && line.contains("points outside the scene folder"),
+        "{line}"
+    );
+    assert_eq!(before, snapshot(&out));
+}
+
+#[test]
 fn symlink_loops() {
     let t = tempfile::tempdir().unwrap();
     let d = obj_scene(t.path(), "self", &box_obj());
