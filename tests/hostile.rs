@@ -291,6 +291,51 @@ fn glb_buffer_view_out_of_bounds() {
 }
 
 #[test]
+fn glb_accessor_layouts_the_reader_cannot_take() {
+    let t = tempfile::tempdir().unwrap();
+    let pos = |j: &Value| {
+        j["meshes"][0]["primitives"][0]["attributes"]["POSITION"]
+            .as_u64()
+            .unwrap() as usize
+    };
+    let idx = |j: &Value| j["meshes"][0]["primitives"][0]["indices"].as_u64().unwrap() as usize;
+    type Edit = fn(&mut Value, usize, usize);
+    let cases: [(&str, Edit, &str); 4] = [
+        (
+            "stride",
+            |j, p, _| {
+                let v = j["accessors"][p]["bufferView"].as_u64().unwrap() as usize;
+                j["bufferViews"][v]["byteStride"] = json!(4);
+            },
+            "has byteStride 4, smaller than one 12-byte element",
+        ),
+        (
+            "u8_positions",
+            |j, p, _| j["accessors"][p]["componentType"] = json!(5121),
+            "(POSITION) is Vec3 U8; glTF requires Vec3 of [F32]",
+        ),
+        (
+            "float_indices",
+            |j, _, i| j["accessors"][i]["componentType"] = json!(5126),
+            "(indices) is Scalar F32",
+        ),
+        (
+            "zero_count",
+            |j, p, _| j["accessors"][p]["count"] = json!(0),
+            "count is 0",
+        ),
+    ];
+    for (case, edit, problem) in cases {
+        let b = edited_glb(false, |j, _| {
+            let (p, i) = (pos(j), idx(j));
+            edit(j, p, i)
+        });
+        let d = sample(t.path(), case, &b);
+        rejects(&d, "object_a.glb", problem);
+    }
+}
+
+#[test]
 fn glb_index_past_vertex_count() {
     let t = tempfile::tempdir().unwrap();
     let b = edited_glb(false, |j, bin| {

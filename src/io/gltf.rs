@@ -288,6 +288,9 @@ fn percent_decode(s: &str) -> String {
 }
 
 fn check_accessor(acc: &gltf::Accessor, buffers: &[Vec<u8>]) -> std::result::Result<(), String> {
+    if acc.count() == 0 {
+        return Err("count is 0 (glTF requires at least 1)".into());
+    }
     if acc.sparse().is_some() {
         return Err("sparse accessors are not supported".into());
     }
@@ -310,6 +313,12 @@ fn check_accessor(acc: &gltf::Accessor, buffers: &[Vec<u8>]) -> std::result::Res
     }
     let elem = acc.size();
     let stride = view.stride().unwrap_or(elem);
+    if stride < elem {
+        return Err(format!(
+            "buffer view {} has byteStride {stride}, smaller than one {elem}-byte element",
+            view.index()
+        ));
+    }
     if acc.count() > 0 {
         let need = acc
             .offset()
@@ -349,10 +358,47 @@ fn read_primitive(
     ) {
         return Ok(None); // points and lines carry no surface
     }
-    let vertex_count = prim
-        .get(&gltf::Semantic::Positions)
-        .map(|a| a.count())
-        .unwrap_or(0);
+    // The gltf crate's readers assume these layouts (and panic or misread otherwise).
+    use gltf::accessor::{DataType, Dimensions};
+    let kind = |acc: &gltf::Accessor, what: &str, dims: Dimensions, types: &[DataType]| {
+        if acc.dimensions() == dims && types.contains(&acc.data_type()) {
+            Ok(())
+        } else {
+            Err(err(format!(
+                "accessor {} ({what}) is {:?} {:?}; glTF requires {dims:?} of {types:?}",
+                acc.index(),
+                acc.dimensions(),
+                acc.data_type()
+            )))
+        }
+    };
+    let Some(pos) = prim.get(&gltf::Semantic::Positions) else {
+        return Err(err("primitive has no POSITION attribute".into()));
+    };
+    kind(&pos, "POSITION", Dimensions::Vec3, &[DataType::F32])?;
+    if let Some(ix) = prim.indices() {
+        kind(
+            &ix,
+            "indices",
+            Dimensions::Scalar,
+            &[DataType::U8, DataType::U16, DataType::U32],
+        )?;
+    }
+    if let Some(info) = prim
+        .material()
+        .pbr_metallic_roughness()
+        .base_color_texture()
+    {
+        if let Some(tc) = prim.get(&gltf::Semantic::TexCoords(info.tex_coord())) {
+            kind(
+                &tc,
+                "TEXCOORD",
+                Dimensions::Vec2,
+                &[DataType::F32, DataType::U8, DataType::U16],
+            )?;
+        }
+    }
+    let vertex_count = pos.count();
     let index_count = prim.indices().map(|a| a.count()).unwrap_or(vertex_count);
     let tris = match mode {
         Mode::Triangles => index_count / 3,
