@@ -508,6 +508,41 @@ fn glb_missing_texture_image() {
 }
 
 #[test]
+fn glb_image_without_mime_type_or_source() {
+    // Found by fuzzing (fuzz target glb): "mimeType" misspelt, so an image in a buffer view had
+    // none, and the gltf crate unwrapped it (a panic). Also: no source at all, and both.
+    let t = tempfile::tempdir().unwrap();
+    for (case, edit, problem) in [
+        (
+            "mime",
+            json!({"bufferView": 4, "mimeVype": "image/png"}),
+            "image 0 is stored in a buffer view but has no mimeType",
+        ),
+        (
+            "none",
+            json!({"name": "x"}),
+            "image 0 has neither a uri nor a bufferView",
+        ),
+        (
+            "both",
+            json!({"bufferView": 4, "mimeType": "image/png", "uri": "x.png"}),
+            "image 0 has both a uri and a bufferView",
+        ),
+    ] {
+        let b = edited_glb(true, |j, _| {
+            let view = j["images"][0]["bufferView"].clone();
+            let mut img = edit;
+            if img.get("bufferView").is_some() {
+                img["bufferView"] = view;
+            }
+            j["images"][0] = img;
+        });
+        let d = sample(t.path(), case, &b);
+        rejects(&d, "object_a.glb", problem);
+    }
+}
+
+#[test]
 fn glb_corrupt_texture_image() {
     let t = tempfile::tempdir().unwrap();
     let image_range = |j: &Value| {

@@ -63,6 +63,16 @@ pub fn load_bytes(path: &Path, bytes: &[u8], root: &Path, limits: &Limits) -> Re
     }
     let gltf = gltf::Gltf::from_slice(bytes).map_err(|e| err(describe(e)))?;
     let doc = &gltf.document;
+    // `gltf::Image::source` unwraps these (found by fuzzing: a misspelt mimeType panicked).
+    for (k, image) in doc.as_json().images.iter().enumerate() {
+        let why = match (&image.buffer_view, &image.uri, &image.mime_type) {
+            (Some(_), None, None) => "is stored in a buffer view but has no mimeType",
+            (Some(_), Some(_), _) => "has both a uri and a bufferView",
+            (None, None, _) => "has neither a uri nor a bufferView",
+            _ => continue,
+        };
+        return Err(err(format!("image {k} {why}")));
+    }
 
     // Buffers.
     let mut blob = gltf.blob.clone();
