@@ -275,6 +275,26 @@ fn glb_accessor_out_of_bounds() {
 }
 
 #[test]
+fn glb_attribute_naming_a_missing_accessor() {
+    // Found by fuzzing (fuzz target glb, 31 crash files, all this one): gltf-json's validation
+    // indexed the accessors with the POSITION index unchecked and panicked.
+    let t = tempfile::tempdir().unwrap();
+    for (case, index, n) in [("past", 5, 3), ("none", 0, 0)] {
+        let b = edited_glb(false, |j, _| {
+            j["meshes"][0]["primitives"][0]["attributes"]["POSITION"] = json!(index);
+            let acc = j["accessors"].as_array_mut().unwrap();
+            acc.truncate(n);
+        });
+        let d = sample(t.path(), case, &b);
+        rejects(
+            &d,
+            "object_a.glb",
+            &format!("mesh 0 primitive 0: attribute POSITION refers to accessor {index}, but there are {n} accessors"),
+        );
+    }
+}
+
+#[test]
 fn glb_buffer_view_out_of_bounds() {
     let t = tempfile::tempdir().unwrap();
     let b = edited_glb(false, |j, _| {

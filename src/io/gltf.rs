@@ -61,6 +61,28 @@ pub fn load_bytes(path: &Path, bytes: &[u8], root: &Path, limits: &Limits) -> Re
             )));
         }
     }
+    // gltf-json 1.4.1's validation indexes `accessors` with the POSITION index unchecked (found
+    // by fuzzing: a POSITION of 5 with 4 accessors panicked): check it first.
+    {
+        let root = gltf.document.as_json();
+        for (m, mesh) in root.meshes.iter().enumerate() {
+            for (p, prim) in mesh.primitives.iter().enumerate() {
+                for (semantic, index) in &prim.attributes {
+                    if index.value() >= root.accessors.len() {
+                        return Err(err(format!(
+                            "mesh {m} primitive {p}: attribute {} refers to accessor {}, but there are {} accessors",
+                            match semantic {
+                                gltf::json::validation::Checked::Valid(s) => s.to_string(),
+                                gltf::json::validation::Checked::Invalid => "(invalid)".into(),
+                            },
+                            index.value(),
+                            root.accessors.len()
+                        )));
+                    }
+                }
+            }
+        }
+    }
     let gltf = gltf::Gltf::from_slice(bytes).map_err(|e| err(describe(e)))?;
     let doc = &gltf.document;
     // `gltf::Image::source` unwraps these (found by fuzzing: a misspelt mimeType panicked).
