@@ -10,6 +10,11 @@ use crate::prepare::{prepare, PrepareOptions, PreparedScene};
 use crate::scene::Scene;
 use nalgebra::{Isometry3, Translation3, UnitQuaternion};
 
+/// Smallest principal moment of inertia (kg·m²) written: MuJoCo 3/4 refuses a `fullinertia`
+/// whose eigenvalues are smaller ("inertia must have positive eigenvalues"; measured: 3e-15
+/// refused, 1e-14 accepted). A 0.6 mm cube of water is at the limit.
+pub const MIN_PRINCIPAL_INERTIA: f64 = 1e-14;
+
 /// Default friction coefficient when the scene gives none.
 pub const DEFAULT_FRICTION: f64 = 0.8;
 
@@ -118,6 +123,18 @@ pub fn assemble(
         let density = o.physical.density.unwrap_or(DEFAULT_DENSITY);
         let mut warnings = o.warnings.clone();
         warnings.extend(notes.get(k).into_iter().flatten().cloned());
+        let smallest = o.geometry.aabb().map(|b| b.extents().min()).unwrap_or(0.0);
+        if hulls.is_empty() && smallest > 0.0 && smallest < dopts.min_thickness {
+            return Err(Error::input(
+                source,
+                format!(
+                    "object {} is too small or too thin to simulate: its smallest extent is {smallest:.3e} m, \
+                     under the {:.1e} m minimum collision hull thickness (MuJoCo refuses such meshes: \
+                     \"mesh volume is too small\"); check the units or scale the scene with --size",
+                    o.name, dopts.min_thickness
+                ),
+            ));
+        }
         if hulls.is_empty() {
             return Err(Error::input(
                 source,
@@ -151,6 +168,19 @@ pub fn assemble(
         inertial
             .check()
             .map_err(|m| Error::input(source, format!("object {}: {m}", o.name)))?;
+        let smallest_moment = inertial.inertia.symmetric_eigenvalues().min();
+        if smallest_moment < MIN_PRINCIPAL_INERTIA {
+            return Err(Error::input(
+                source,
+                format!(
+                    "object {} is too small or too light to simulate: mass {:.3e} kg, smallest \
+                     principal moment of inertia {smallest_moment:.3e} kg·m², under the \
+                     {MIN_PRINCIPAL_INERTIA:.0e} MuJoCo accepts; check the units, scale the scene \
+                     with --size, or give it a larger mass",
+                    o.name, inertial.mass
+                ),
+            ));
+        }
         let com = inertial.com;
         let to_body =
             Isometry3::from_parts(Translation3::from(-com.coords), UnitQuaternion::identity());

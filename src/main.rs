@@ -4,6 +4,7 @@
 
 use clap::{Args, Parser, Subcommand};
 use interact3d::body::Engine;
+use interact3d::io::Limits;
 use interact3d::Error;
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -77,12 +78,38 @@ impl CheckArgs {
     }
 }
 
+/// Size limits on what is read: a file over one is refused with an error naming the limit.
+#[derive(Args, Clone)]
+struct LimitsArgs {
+    /// Largest input file read (mesh, texture, manifest), bytes.
+    #[arg(long, value_name = "BYTES", default_value_t = Limits::default().max_file_bytes)]
+    max_file_bytes: u64,
+    /// Most triangles in one mesh file.
+    #[arg(long, value_name = "N", default_value_t = Limits::default().max_triangles)]
+    max_triangles: usize,
+    /// Most pixels (width x height) in one texture image.
+    #[arg(long, value_name = "N", default_value_t = Limits::default().max_texture_pixels)]
+    max_texture_pixels: u64,
+}
+
+impl LimitsArgs {
+    fn limits(&self) -> Limits {
+        Limits {
+            max_file_bytes: self.max_file_bytes,
+            max_triangles: self.max_triangles,
+            max_texture_pixels: self.max_texture_pixels,
+        }
+    }
+}
+
 #[derive(Args)]
 struct ValidateArgs {
     /// A scene (sample folder, scene.json, mesh file) or an export output folder.
     path: PathBuf,
     #[command(flatten)]
     build: BuildArgs,
+    #[command(flatten)]
+    limits: LimitsArgs,
     #[command(flatten)]
     check: CheckArgs,
     /// Print the whole validation report as JSON on stdout.
@@ -124,6 +151,8 @@ struct ExportArgs {
     out: PathBuf,
     #[command(flatten)]
     build: BuildArgs,
+    #[command(flatten)]
+    limits: LimitsArgs,
     /// Folder of templates overriding the built-in ones (scene.xml.j2, object.xml.j2, object.urdf.j2).
     #[arg(long)]
     templates: Option<PathBuf>,
@@ -181,6 +210,8 @@ struct BatchArgs {
     progress: ProgressArg,
     #[command(flatten)]
     build: BuildArgs,
+    #[command(flatten)]
+    limits: LimitsArgs,
     /// Folder of templates overriding the built-in ones.
     #[arg(long)]
     templates: Option<PathBuf>,
@@ -236,6 +267,7 @@ fn run(cli: Cli) -> Result<ExitCode, Error> {
     match cli.command {
         Command::Export(a) => {
             let job = interact3d::pipeline::ExportJob {
+                limits: a.limits.limits(),
                 build: a.build.options(),
                 export: interact3d::export::ExportOptions {
                     templates: a.templates,
@@ -291,7 +323,7 @@ fn run(cli: Cli) -> Result<ExitCode, Error> {
             let t = std::time::Instant::now();
             let (assembly, v) = interact3d::pipeline::validate_path(
                 &a.path,
-                &Default::default(),
+                &a.limits.limits(),
                 &a.build.options(),
                 &a.check.options(),
             )?;
@@ -349,6 +381,7 @@ fn batch(a: BatchArgs) -> Result<ExitCode, Error> {
         ));
     };
     let job = interact3d::pipeline::ExportJob {
+        limits: a.limits.limits(),
         build: a.build.options(),
         export: interact3d::export::ExportOptions {
             templates: a.templates,

@@ -191,55 +191,6 @@ fn same_input_same_bytes() {
     }
 }
 
-/// Run export on a broken scene: exit 2, one line naming `culprit`, nothing written.
-fn rejects(dir: &Path, culprit: &str, problem: &str) {
-    let before = snapshot(dir);
-    let out = dir.parent().unwrap().join("never");
-    let (code, stdout, stderr) =
-        run(&["export", dir.to_str().unwrap(), "-o", out.to_str().unwrap()]);
-    assert_eq!(code, 2, "{stderr}");
-    assert!(stdout.is_empty());
-    let line = stderr.trim();
-    assert_eq!(line.lines().count(), 1, "one line: {line}");
-    assert!(
-        line.contains(culprit) && line.contains(problem),
-        "expected {culprit:?} and {problem:?} in: {line}"
-    );
-    assert!(!out.exists(), "no output folder");
-    let leftovers: Vec<_> = fs::read_dir(dir.parent().unwrap())
-        .unwrap()
-        .filter_map(|e| e.ok())
-        .filter(|e| e.file_name().to_string_lossy().starts_with(".interact3d"))
-        .collect();
-    assert!(
-        leftovers.is_empty(),
-        "temporary folders left: {leftovers:?}"
-    );
-    assert_eq!(before, snapshot(dir), "inputs untouched");
-}
-
-fn snapshot(dir: &Path) -> Vec<(String, Vec<u8>)> {
-    let mut v: Vec<_> = walk(dir)
-        .into_iter()
-        .map(|p| (p.display().to_string(), fs::read(&p).unwrap()))
-        .collect();
-    v.sort();
-    v
-}
-
-fn walk(dir: &Path) -> Vec<std::path::PathBuf> {
-    let mut out = Vec::new();
-    for e in fs::read_dir(dir).unwrap().filter_map(|e| e.ok()) {
-        let p = e.path();
-        if p.is_dir() {
-            out.extend(walk(&p));
-        } else {
-            out.push(p);
-        }
-    }
-    out
-}
-
 #[test]
 fn bad_inputs_exit_2_with_one_line_and_no_output() {
     let t = tempfile::tempdir().unwrap();

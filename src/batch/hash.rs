@@ -61,13 +61,25 @@ pub fn input_files(entry: &SceneEntry) -> Result<Vec<(String, PathBuf)>> {
                 }
             }
         }
-        SceneKind::Manifest => walk(&entry.dir, "", &mut files)?,
+        SceneKind::Manifest => {
+            let mut seen = std::collections::HashSet::new();
+            walk(&entry.dir, "", &mut seen, &mut files)?
+        }
     }
     files.sort();
     Ok(files)
 }
 
-fn walk(dir: &Path, rel: &str, out: &mut Vec<(String, PathBuf)>) -> Result<()> {
+/// Every file below `dir`; links to folders are followed once (a link back up is not a loop).
+fn walk(
+    dir: &Path,
+    rel: &str,
+    seen: &mut std::collections::HashSet<PathBuf>,
+    out: &mut Vec<(String, PathBuf)>,
+) -> Result<()> {
+    if !seen.insert(dir.canonicalize().map_err(|e| Error::io(dir, e))?) {
+        return Ok(());
+    }
     for e in std::fs::read_dir(dir).map_err(|e| Error::io(dir, e))? {
         let e = e.map_err(|e| Error::io(dir, e))?;
         let name = e.file_name().to_string_lossy().into_owned();
@@ -78,7 +90,7 @@ fn walk(dir: &Path, rel: &str, out: &mut Vec<(String, PathBuf)>) -> Result<()> {
         };
         let p = e.path();
         if p.is_dir() {
-            walk(&p, &r, out)?;
+            walk(&p, &r, seen, out)?;
         } else if p.is_file() {
             out.push((r, p));
         }

@@ -38,7 +38,7 @@ pub fn load(path: &Path, limits: &Limits) -> Result<Assembly> {
         path.to_path_buf()
     };
     let root = mpath.parent().unwrap_or(Path::new(".")).to_path_buf();
-    let m = manifest::read(&mpath)?;
+    let m = manifest::read_with(&mpath, limits)?;
     let mut bodies = Vec::new();
     for o in &m.objects {
         let err = |msg: String| Error::input(&mpath, format!("object {:?}: {msg}", o.name));

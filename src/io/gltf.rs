@@ -38,6 +38,18 @@ pub fn load(path: &Path, limits: &Limits) -> Result<VisualMesh> {
 /// `root` is the folder no URI may leave.
 pub fn load_bytes(path: &Path, bytes: &[u8], root: &Path, limits: &Limits) -> Result<VisualMesh> {
     let err = |m: String| Error::input(path, m);
+    let is_glb_name = path
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("glb"));
+    if bytes.starts_with(b"glTF") {
+        check_glb_container(bytes).map_err(err)?;
+    } else if is_glb_name {
+        let head = &bytes[..bytes.len().min(4)];
+        return Err(err(format!(
+            "not a GLB file: it starts with {:?}, not the magic \"glTF\"",
+            String::from_utf8_lossy(head)
+        )));
+    }
     // The JSON is checked for extensions before the gltf crate validates (it rejects Draco with
     // a less helpful message).
     let gltf = gltf::Gltf::from_slice_without_validation(bytes).map_err(|e| err(describe(e)))?;
@@ -49,8 +61,40 @@ pub fn load_bytes(path: &Path, bytes: &[u8], root: &Path, limits: &Limits) -> Re
             )));
         }
     }
+    // gltf-json 1.4.1's validation indexes `accessors` with the POSITION index unchecked (found
+    // by fuzzing: a POSITION of 5 with 4 accessors panicked): check it first.
+    {
+        let root = gltf.document.as_json();
+        for (m, mesh) in root.meshes.iter().enumerate() {
+            for (p, prim) in mesh.primitives.iter().enumerate() {
+                for (semantic, index) in &prim.attributes {
+                    if index.value() >= root.accessors.len() {
+                        return Err(err(format!(
+                            "mesh {m} primitive {p}: attribute {} refers to accessor {}, but there are {} accessors",
+                            match semantic {
+                                gltf::json::validation::Checked::Valid(s) => s.to_string(),
+                                gltf::json::validation::Checked::Invalid => "(invalid)".into(),
+                            },
+                            index.value(),
+                            root.accessors.len()
+                        )));
+                    }
+                }
+            }
+        }
+    }
     let gltf = gltf::Gltf::from_slice(bytes).map_err(|e| err(describe(e)))?;
     let doc = &gltf.document;
+    // `gltf::Image::source` unwraps these (found by fuzzing: a misspelt mimeType panicked).
+    for (k, image) in doc.as_json().images.iter().enumerate() {
+        let why = match (&image.buffer_view, &image.uri, &image.mime_type) {
+            (Some(_), None, None) => "is stored in a buffer view but has no mimeType",
+            (Some(_), Some(_), _) => "has both a uri and a bufferView",
+            (None, None, _) => "has neither a uri nor a bufferView",
+            _ => continue,
+        };
+        return Err(err(format!("image {k} {why}")));
+    }
 
     // Buffers.
     let mut blob = gltf.blob.clone();
@@ -82,15 +126,42 @@ pub fn load_bytes(path: &Path, bytes: &[u8], root: &Path, limits: &Limits) -> Re
         Some(s) => vec![s],
         None => doc.scenes().collect(),
     };
+    // The node hierarchy must be a forest (glTF 2.0, 5.25): one parent at most, scene roots
+    // without one. Checked up front, so the walk below visits each node once per scene and a
+    // cycle is an error, not a million visits.
+    let mut parent: Vec<Option<usize>> = vec![None; doc.nodes().len()];
+    for n in doc.nodes() {
+        for c in n.children() {
+            if c.index() == n.index() || parent[c.index()].replace(n.index()).is_some() {
+                return Err(err(format!(
+                    "node {} has more than one parent or is its own child: the node hierarchy must be a tree",
+                    c.index()
+                )));
+            }
+        }
+    }
+    for scene in &scenes {
+        for n in scene.nodes() {
+            if let Some(p) = parent[n.index()] {
+                return Err(err(format!(
+                    "scene root node {} is also a child of node {p}: the node hierarchy must be a tree",
+                    n.index()
+                )));
+            }
+        }
+    }
     let mut textures: BTreeMap<usize, Texture> = BTreeMap::new();
     let mut parts = Vec::new();
     let mut stack: Vec<(gltf::Node, Matrix4<f64>)> = Vec::new();
-    for scene in scenes {
+    for scene in &scenes {
         for node in scene.nodes() {
             stack.push((node, Matrix4::identity()));
         }
     }
     let mut visited = 0usize;
+    // Triangles and vertices counted from the accessors before anything is read: a small file
+    // that instances a mesh a million times cannot make us allocate gigabytes.
+    let mut budget = Budget::default();
     while let Some((node, parent)) = stack.pop() {
         visited += 1;
         if visited > 1_000_000 {
@@ -100,9 +171,16 @@ pub fn load_bytes(path: &Path, bytes: &[u8], root: &Path, limits: &Limits) -> Re
         let world = parent * local;
         if let Some(mesh) = node.mesh() {
             for prim in mesh.primitives() {
-                if let Some(part) =
-                    read_primitive(path, root, &prim, &buffers, &world, &mut textures, limits)?
-                {
+                if let Some(part) = read_primitive(
+                    path,
+                    root,
+                    &prim,
+                    &buffers,
+                    &world,
+                    &mut textures,
+                    &mut budget,
+                    limits,
+                )? {
                     parts.push(part);
                 }
             }
@@ -112,6 +190,80 @@ pub fn load_bytes(path: &Path, bytes: &[u8], root: &Path, limits: &Limits) -> Re
         }
     }
     Ok(VisualMesh { parts })
+}
+
+/// Check the GLB header and chunk table before the `gltf` crate reads them (it subtracts
+/// without checking and its messages are terse): version 2, declared length within the file,
+/// a JSON chunk first, every chunk inside the declared length.
+fn check_glb_container(bytes: &[u8]) -> std::result::Result<(), String> {
+    let n = bytes.len() as u64;
+    if n < 12 {
+        return Err(format!(
+            "truncated GLB: {n} bytes, shorter than the 12-byte header"
+        ));
+    }
+    let u32_at = |o: u64| -> u64 {
+        let o = o as usize;
+        u32::from_le_bytes([bytes[o], bytes[o + 1], bytes[o + 2], bytes[o + 3]]) as u64
+    };
+    let version = u32_at(4);
+    if version != 2 {
+        return Err(format!(
+            "unsupported GLB version {version} (only glTF 2.0 is read)"
+        ));
+    }
+    let length = u32_at(8);
+    if length > n {
+        return Err(format!(
+            "truncated GLB: the header declares {length} bytes but the file has {n}"
+        ));
+    }
+    if length < 20 {
+        return Err(format!(
+            "corrupt GLB: the header declares {length} bytes, too few for a JSON chunk"
+        ));
+    }
+    let mut offset = 12u64;
+    let mut k = 0;
+    while offset < length {
+        if offset + 8 > length {
+            return Err(format!(
+                "corrupt GLB: chunk {k} header at byte {offset} runs past the declared length {length}"
+            ));
+        }
+        let chunk_len = u32_at(offset);
+        let ty = &bytes[offset as usize + 4..offset as usize + 8];
+        let name = match ty {
+            b"JSON" => "JSON",
+            b"BIN\0" => "BIN",
+            _ => "unknown",
+        };
+        if k == 0 && name != "JSON" {
+            return Err("corrupt GLB: the first chunk is not the JSON chunk".into());
+        }
+        if k == 1 && name != "BIN" {
+            return Err(format!(
+                "corrupt GLB: the second chunk has type {:?}, not BIN",
+                String::from_utf8_lossy(ty)
+            ));
+        }
+        let left = length - offset - 8;
+        if chunk_len > left {
+            return Err(format!(
+                "corrupt GLB: chunk {k} ({name}) declares {chunk_len} bytes but only {left} remain (truncated or corrupt)"
+            ));
+        }
+        offset += 8 + chunk_len;
+        k += 1;
+    }
+    Ok(())
+}
+
+/// Triangles and vertices taken so far, over all primitive instances.
+#[derive(Default)]
+struct Budget {
+    triangles: usize,
+    vertices: usize,
 }
 
 fn describe(e: gltf::Error) -> String {
@@ -132,7 +284,10 @@ fn read_uri(path: &Path, root: &Path, uri: &str, limits: &Limits) -> Result<Vec<
             .split_once(";base64,")
             .ok_or_else(|| Error::input(path, "data: URI is not base64-encoded"))?;
         if data.len() as u64 / 4 * 3 > limits.max_file_bytes {
-            return Err(Error::input(path, "data: URI is over the file size limit"));
+            return Err(Error::input(
+                path,
+                "data: URI is over the file size limit (--max-file-bytes)",
+            ));
         }
         return base64::engine::general_purpose::STANDARD
             .decode(data.trim())
@@ -144,13 +299,16 @@ fn read_uri(path: &Path, root: &Path, uri: &str, limits: &Limits) -> Result<Vec<
 }
 
 fn percent_decode(s: &str) -> String {
+    // On bytes: a `%` followed by anything but two hex digits is kept as it is (slicing the
+    // `str` there could split a multi-byte character).
     let b = s.as_bytes();
+    let hex = |c: u8| (c as char).to_digit(16).map(|d| d as u8);
     let mut out = Vec::with_capacity(b.len());
     let mut i = 0;
     while i < b.len() {
         if b[i] == b'%' && i + 2 < b.len() {
-            if let Ok(v) = u8::from_str_radix(&s[i + 1..i + 3], 16) {
-                out.push(v);
+            if let (Some(h), Some(l)) = (hex(b[i + 1]), hex(b[i + 2])) {
+                out.push(h * 16 + l);
                 i += 3;
                 continue;
             }
@@ -162,6 +320,9 @@ fn percent_decode(s: &str) -> String {
 }
 
 fn check_accessor(acc: &gltf::Accessor, buffers: &[Vec<u8>]) -> std::result::Result<(), String> {
+    if acc.count() == 0 {
+        return Err("count is 0 (glTF requires at least 1)".into());
+    }
     if acc.sparse().is_some() {
         return Err("sparse accessors are not supported".into());
     }
@@ -184,6 +345,12 @@ fn check_accessor(acc: &gltf::Accessor, buffers: &[Vec<u8>]) -> std::result::Res
     }
     let elem = acc.size();
     let stride = view.stride().unwrap_or(elem);
+    if stride < elem {
+        return Err(format!(
+            "buffer view {} has byteStride {stride}, smaller than one {elem}-byte element",
+            view.index()
+        ));
+    }
     if acc.count() > 0 {
         let need = acc
             .offset()
@@ -212,6 +379,7 @@ fn read_primitive(
     buffers: &[Vec<u8>],
     world: &Matrix4<f64>,
     textures: &mut BTreeMap<usize, Texture>,
+    budget: &mut Budget,
     limits: &Limits,
 ) -> Result<Option<VisualPart>> {
     let err = |m: String| Error::input(path, m);
@@ -221,6 +389,62 @@ fn read_primitive(
         Mode::Triangles | Mode::TriangleStrip | Mode::TriangleFan
     ) {
         return Ok(None); // points and lines carry no surface
+    }
+    // The gltf crate's readers assume these layouts (and panic or misread otherwise).
+    use gltf::accessor::{DataType, Dimensions};
+    let kind = |acc: &gltf::Accessor, what: &str, dims: Dimensions, types: &[DataType]| {
+        if acc.dimensions() == dims && types.contains(&acc.data_type()) {
+            Ok(())
+        } else {
+            Err(err(format!(
+                "accessor {} ({what}) is {:?} {:?}; glTF requires {dims:?} of {types:?}",
+                acc.index(),
+                acc.dimensions(),
+                acc.data_type()
+            )))
+        }
+    };
+    let Some(pos) = prim.get(&gltf::Semantic::Positions) else {
+        return Err(err("primitive has no POSITION attribute".into()));
+    };
+    kind(&pos, "POSITION", Dimensions::Vec3, &[DataType::F32])?;
+    if let Some(ix) = prim.indices() {
+        kind(
+            &ix,
+            "indices",
+            Dimensions::Scalar,
+            &[DataType::U8, DataType::U16, DataType::U32],
+        )?;
+    }
+    if let Some(info) = prim
+        .material()
+        .pbr_metallic_roughness()
+        .base_color_texture()
+    {
+        if let Some(tc) = prim.get(&gltf::Semantic::TexCoords(info.tex_coord())) {
+            kind(
+                &tc,
+                "TEXCOORD",
+                Dimensions::Vec2,
+                &[DataType::F32, DataType::U8, DataType::U16],
+            )?;
+        }
+    }
+    let vertex_count = pos.count();
+    let index_count = prim.indices().map(|a| a.count()).unwrap_or(vertex_count);
+    let tris = match mode {
+        Mode::Triangles => index_count / 3,
+        _ => index_count.saturating_sub(2),
+    };
+    budget.triangles = budget.triangles.saturating_add(tris);
+    budget.vertices = budget.vertices.saturating_add(vertex_count);
+    if budget.triangles > limits.max_triangles
+        || budget.vertices > limits.max_triangles.saturating_mul(3)
+    {
+        return Err(err(format!(
+            "mesh has more than {} triangles (or 3x as many vertices), over the limit (--max-triangles)",
+            limits.max_triangles
+        )));
     }
     let reader = prim.reader(|b| buffers.get(b.index()).map(|d| d.as_slice()));
     let positions: Vec<P3> = reader
@@ -323,8 +547,10 @@ fn read_image(
     let origin = format!("{}#image{}", path.display(), image.index());
     let bytes = match image.source() {
         gltf::image::Source::View { view, .. } => {
-            let buf = &buffers[view.buffer().index()];
-            let end = view.offset() + view.length();
+            let buf = buffers
+                .get(view.buffer().index())
+                .ok_or_else(|| Error::input(&origin, "image refers to a missing buffer"))?;
+            let end = view.offset().saturating_add(view.length());
             if end > buf.len() {
                 return Err(Error::input(
                     &origin,

@@ -44,7 +44,7 @@ pub fn read_file(path: &Path, limits: &Limits) -> Result<Vec<u8>> {
         return Err(Error::input(
             path,
             format!(
-                "file is {} bytes, over the limit of {} bytes",
+                "file is {} bytes, over the limit of {} bytes (--max-file-bytes)",
                 meta.len(),
                 limits.max_file_bytes
             ),
@@ -53,26 +53,63 @@ pub fn read_file(path: &Path, limits: &Limits) -> Result<Vec<u8>> {
     std::fs::read(path).map_err(|e| Error::io(path, e))
 }
 
-/// Load a visual mesh by extension: `.glb`, `.gltf`, `.obj`, `.stl`.
+/// Load a visual mesh by extension: `.glb`, `.gltf`, `.obj`, `.stl`. References inside the
+/// file (buffers, images, MTL, textures) must stay inside the file's own folder.
 pub fn load_visual(path: &Path, limits: &Limits) -> Result<VisualMesh> {
+    format_of(path)?;
+    let bytes = read_file(path, limits)?;
+    load_visual_bytes(
+        path,
+        &bytes,
+        path.parent().unwrap_or(Path::new(".")),
+        limits,
+    )
+}
+
+/// Load a visual mesh from bytes already read (the byte-level entry point, also what the fuzz
+/// targets call): `path` names the file in errors and gives its format by extension, relative
+/// references start from its folder and may not leave `root`. Runs [`check_visual`].
+pub fn load_visual_bytes(
+    path: &Path,
+    bytes: &[u8],
+    root: &Path,
+    limits: &Limits,
+) -> Result<VisualMesh> {
+    if bytes.len() as u64 > limits.max_file_bytes {
+        return Err(Error::input(
+            path,
+            format!(
+                "file is {} bytes, over the limit of {} bytes (--max-file-bytes)",
+                bytes.len(),
+                limits.max_file_bytes
+            ),
+        ));
+    }
+    let mesh = match format_of(path)? {
+        "gltf" => gltf::load_bytes(path, bytes, root, limits)?,
+        "obj" => obj::load_bytes(path, bytes, root, limits)?,
+        _ => stl::load_bytes(path, bytes, limits)?,
+    };
+    check_visual(path, &mesh, limits)?;
+    Ok(mesh)
+}
+
+/// The reader for a file name: "gltf" (`.glb`, `.gltf`), "obj" or "stl".
+fn format_of(path: &Path) -> Result<&'static str> {
     let ext = path
         .extension()
         .and_then(|e| e.to_str())
         .map(|e| e.to_ascii_lowercase())
         .unwrap_or_default();
-    let mesh = match ext.as_str() {
-        "glb" | "gltf" => gltf::load(path, limits)?,
-        "obj" => obj::load(path, limits)?,
-        "stl" => stl::load(path, limits)?,
-        _ => {
-            return Err(Error::input(
-                path,
-                "unsupported mesh format (expected .glb, .gltf, .obj or .stl)",
-            ))
-        }
-    };
-    check_visual(path, &mesh, limits)?;
-    Ok(mesh)
+    match ext.as_str() {
+        "glb" | "gltf" => Ok("gltf"),
+        "obj" => Ok("obj"),
+        "stl" => Ok("stl"),
+        _ => Err(Error::input(
+            path,
+            "unsupported mesh format (expected .glb, .gltf, .obj or .stl)",
+        )),
+    }
 }
 
 /// The checks every loaded mesh passes: finite, sane coordinates, valid indices, not empty.
@@ -85,7 +122,7 @@ pub fn check_visual(path: &Path, mesh: &VisualMesh, limits: &Limits) -> Result<(
         return Err(Error::input(
             path,
             format!(
-                "mesh has {tris} triangles, over the limit of {}",
+                "mesh has {tris} triangles, over the limit of {} (--max-triangles)",
                 limits.max_triangles
             ),
         ));

@@ -17,7 +17,13 @@ pub fn load(path: &Path, limits: &Limits) -> Result<VisualMesh> {
 /// Load an OBJ whose references must stay inside `root`.
 pub fn load_in(path: &Path, root: &Path, limits: &Limits) -> Result<VisualMesh> {
     let bytes = crate::io::read_file(path, limits)?;
-    let text = String::from_utf8_lossy(&bytes);
+    load_bytes(path, &bytes, root, limits)
+}
+
+/// Parse OBJ bytes; `path` names the file in errors and is where the MTL path starts from; no
+/// reference may leave `root`.
+pub fn load_bytes(path: &Path, bytes: &[u8], root: &Path, limits: &Limits) -> Result<VisualMesh> {
+    let text = String::from_utf8_lossy(bytes);
     // tobj silently drops out-of-range indices and treats 0 as valid; check indices ourselves.
     check_indices(path, &text)?;
     let opts = tobj::LoadOptions {
@@ -27,16 +33,13 @@ pub fn load_in(path: &Path, root: &Path, limits: &Limits) -> Result<VisualMesh> 
         ignore_lines: true,
     };
     let mtl_error: std::cell::RefCell<Option<Error>> = std::cell::RefCell::new(None);
-    let (models, materials) = tobj::load_obj_buf(&mut bytes.as_slice(), &opts, |mtl| {
+    let (models, materials) = tobj::load_obj_buf(&mut &bytes[..], &opts, |mtl| {
         let name = mtl.to_string_lossy();
         match resolve_inside(root, path, &name) {
-            Ok(file) => match std::fs::read(&file) {
+            Ok(file) => match crate::io::read_file(&file, limits) {
                 Ok(b) => tobj::load_mtl_buf(&mut b.as_slice()),
                 Err(e) => {
-                    *mtl_error.borrow_mut() = Some(Error::input(
-                        path,
-                        format!("material library {name:?}: {e}"),
-                    ));
+                    *mtl_error.borrow_mut() = Some(e);
                     Err(tobj::LoadError::OpenFileFailed)
                 }
             },
@@ -154,7 +157,8 @@ fn check_indices(path: &Path, text: &str) -> Result<()> {
                                 format!("line {}: bad face index {field:?}", lineno + 1),
                             )
                         })?;
-                        let ok = (i > 0 && i <= count) || (i < 0 && -i <= count);
+                        // unsigned_abs: -i64::MIN would overflow.
+                        let ok = i != 0 && i.unsigned_abs() <= count as u64;
                         if !ok {
                             return Err(Error::input(
                                 path,

@@ -8,7 +8,12 @@ use std::path::Path;
 /// Load an STL file (binary or ASCII, told apart by size and content, not by the `solid` word).
 pub fn load(path: &Path, limits: &Limits) -> Result<VisualMesh> {
     let bytes = crate::io::read_file(path, limits)?;
-    let soup = parse(&bytes, limits).map_err(|m| Error::input(path, m))?;
+    load_bytes(path, &bytes, limits)
+}
+
+/// Parse STL bytes; `path` names the file in errors.
+pub fn load_bytes(path: &Path, bytes: &[u8], limits: &Limits) -> Result<VisualMesh> {
+    let soup = parse(bytes, limits).map_err(|m| Error::input(path, m))?;
     // STL stores every triangle's corners separately: weld exact duplicates.
     let n = soup.len();
     let mesh = Mesh::new(
@@ -60,7 +65,7 @@ fn parse_binary(
 ) -> std::result::Result<Vec<P3>, String> {
     if count > limits.max_triangles {
         return Err(format!(
-            "STL has {count} triangles, over the limit of {}",
+            "STL has {count} triangles, over the limit of {} (--max-triangles)",
             limits.max_triangles
         ));
     }
@@ -109,7 +114,7 @@ fn parse_ascii(bytes: &[u8], limits: &Limits) -> std::result::Result<Vec<P3>, St
         }
         if out.len() / 3 > limits.max_triangles {
             return Err(format!(
-                "STL has more than {} triangles",
+                "STL has more than {} triangles, over the limit (--max-triangles)",
                 limits.max_triangles
             ));
         }

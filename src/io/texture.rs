@@ -24,7 +24,7 @@ pub fn from_bytes(origin: &str, bytes: Vec<u8>, limits: &Limits) -> Result<Textu
     }
     if width as u64 * height as u64 > limits.max_texture_pixels {
         return Err(err(format!(
-            "texture is {width}x{height} pixels, over the limit of {} pixels",
+            "texture is {width}x{height} pixels, over the limit of {} pixels (--max-texture-pixels)",
             limits.max_texture_pixels
         )));
     }

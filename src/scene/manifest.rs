@@ -164,8 +164,18 @@ pub struct InertialSpec {
 
 /// Read and check a manifest without loading its meshes.
 pub fn read(path: &Path) -> Result<Manifest> {
-    let text = std::fs::read_to_string(path).map_err(|e| Error::io(path, e))?;
-    let m: Manifest = serde_json::from_str(&text)
+    read_with(path, &Limits::default())
+}
+
+/// [`read`] with the file size limit of `limits`.
+pub fn read_with(path: &Path, limits: &Limits) -> Result<Manifest> {
+    parse(path, &crate::io::read_file(path, limits)?)
+}
+
+/// Parse and check manifest bytes (`path` names the file in errors): the JSON, its format and
+/// version, units, poses and physical values. Meshes are not touched.
+pub fn parse(path: &Path, bytes: &[u8]) -> Result<Manifest> {
+    let m: Manifest = serde_json::from_slice(bytes)
         .map_err(|e| Error::input(path, format!("invalid scene manifest: {e}")))?;
     if m.format != FORMAT {
         return Err(Error::input(
@@ -179,26 +189,12 @@ pub fn read(path: &Path) -> Result<Manifest> {
             format!("unsupported manifest version {}", m.version),
         ));
     }
-    Ok(m)
-}
-
-/// Load a manifest and its meshes.
-pub fn load(path: &Path, limits: &Limits) -> Result<Scene> {
-    let m = read(path)?;
-    let root = path.parent().unwrap_or(Path::new(".")).to_path_buf();
-    let root = if root.as_os_str().is_empty() {
-        Path::new(".").to_path_buf()
-    } else {
-        root
-    };
-    let meters_per_unit = m.units.meters().map_err(|e| Error::input(path, e))?;
-    let mut objects = Vec::with_capacity(m.objects.len());
+    m.units.meters().map_err(|e| Error::input(path, e))?;
     for o in &m.objects {
         let ctx = |msg: String| Error::input(path, format!("object {:?}: {msg}", o.name));
-        let pose = match &o.pose {
-            Some(p) => p.to_similarity().map_err(ctx)?,
-            None => Similarity::identity(),
-        };
+        if let Some(p) = &o.pose {
+            p.to_similarity().map_err(ctx)?;
+        }
         for (what, v) in [
             ("density", o.density),
             ("mass", o.mass),
@@ -210,6 +206,30 @@ pub fn load(path: &Path, limits: &Limits) -> Result<Scene> {
                 }
             }
         }
+    }
+    // Names are checked before any mesh is read: a hostile name never reaches a file name.
+    check_names(path, m.objects.iter().map(|o| o.name.as_str()))?;
+    Ok(m)
+}
+
+/// Load a manifest and its meshes.
+pub fn load(path: &Path, limits: &Limits) -> Result<Scene> {
+    let m = read_with(path, limits)?;
+    let root = path.parent().unwrap_or(Path::new(".")).to_path_buf();
+    let root = if root.as_os_str().is_empty() {
+        Path::new(".").to_path_buf()
+    } else {
+        root
+    };
+    let meters_per_unit = m.units.meters().map_err(|e| Error::input(path, e))?;
+    let mut objects = Vec::with_capacity(m.objects.len());
+    for o in &m.objects {
+        let pose = match &o.pose {
+            Some(p) => p
+                .to_similarity()
+                .map_err(|e| Error::input(path, format!("object {:?}: {e}", o.name)))?,
+            None => Similarity::identity(),
+        };
         let mesh_path = resolve_inside(&root, path, &o.mesh)?;
         let visual = crate::io::load_visual(&mesh_path, limits)?;
         objects.push(SceneObject {
@@ -226,7 +246,6 @@ pub fn load(path: &Path, limits: &Limits) -> Result<Scene> {
             },
         });
     }
-    check_names(path, &objects)?;
     let name = m.name.clone().unwrap_or_else(|| {
         root.canonicalize()
             .ok()

@@ -166,27 +166,29 @@ pub fn is_valid_name(name: &str) -> bool {
         && name.len() <= 64
 }
 
-/// Check names: valid and unique.
-pub(crate) fn check_names(source: &Path, objects: &[SceneObject]) -> Result<()> {
+/// Check names: valid and unique, and at least one.
+pub(crate) fn check_names<'a>(
+    source: &Path,
+    names: impl IntoIterator<Item = &'a str>,
+) -> Result<()> {
     let mut seen = std::collections::BTreeSet::new();
-    for o in objects {
-        if !is_valid_name(&o.name) {
+    for name in names {
+        if !is_valid_name(name) {
             return Err(Error::input(
                 source,
                 format!(
-                    "object name {:?} is not a valid identifier (letters, digits, '_' and '-', starting with a letter or '_', at most 64)",
-                    o.name
+                    "object name {name:?} is not a valid identifier (letters, digits, '_' and '-', starting with a letter or '_', at most 64)"
                 ),
             ));
         }
-        if !seen.insert(o.name.as_str()) {
+        if !seen.insert(name) {
             return Err(Error::input(
                 source,
-                format!("duplicate object name {:?}", o.name),
+                format!("duplicate object name {name:?}"),
             ));
         }
     }
-    if objects.is_empty() {
+    if seen.is_empty() {
         return Err(Error::input(source, "scene has no objects"));
     }
     Ok(())

@@ -12,13 +12,8 @@ use std::path::Path;
 /// Load a sample folder.
 pub fn load(dir: &Path, limits: &Limits) -> Result<Scene> {
     let meta_path = dir.join("metadata.json");
-    let text = std::fs::read_to_string(&meta_path).map_err(|e| Error::io(&meta_path, e))?;
-    let meta: Value = serde_json::from_str(&text)
-        .map_err(|e| Error::input(&meta_path, format!("malformed JSON: {e}")))?;
-    let transforms = meta
-        .pointer("/registration/transforms")
-        .and_then(Value::as_object)
-        .ok_or_else(|| Error::input(&meta_path, "missing registration.transforms"))?;
+    let meta = parse_metadata(&meta_path, &crate::io::read_file(&meta_path, limits)?)?;
+    let transforms = transforms_of(&meta_path, &meta)?;
 
     // The objects are the object_*.glb files; each needs a transform.
     let mut names: Vec<String> = Vec::new();
@@ -36,6 +31,8 @@ pub fn load(dir: &Path, limits: &Limits) -> Result<Scene> {
     if names.is_empty() {
         return Err(Error::input(dir, "sample folder has no object_*.glb files"));
     }
+    // Names come from file names: checked before any mesh is read.
+    check_names(&meta_path, names.iter().map(String::as_str))?;
     for key in transforms.keys() {
         if !names.contains(key) {
             return Err(Error::input(
@@ -71,7 +68,6 @@ pub fn load(dir: &Path, limits: &Limits) -> Result<Scene> {
             physical: Physical::default(),
         });
     }
-    check_names(&meta_path, &objects)?;
     let name = dir
         .canonicalize()
         .ok()
@@ -85,6 +81,35 @@ pub fn load(dir: &Path, limits: &Limits) -> Result<Scene> {
         objects,
         warnings: Vec::new(),
     })
+}
+
+/// Parse `metadata.json` bytes (`meta_path` names the file in errors).
+pub fn parse_metadata(meta_path: &Path, bytes: &[u8]) -> Result<Value> {
+    serde_json::from_slice(bytes)
+        .map_err(|e| Error::input(meta_path, format!("malformed JSON: {e}")))
+}
+
+fn transforms_of<'a>(
+    meta_path: &Path,
+    meta: &'a Value,
+) -> Result<&'a serde_json::Map<String, Value>> {
+    meta.pointer("/registration/transforms")
+        .and_then(Value::as_object)
+        .ok_or_else(|| Error::input(meta_path, "missing registration.transforms"))
+}
+
+/// Every transform of `metadata.json` bytes, checked (the byte-level entry point the fuzz
+/// target calls; [`load`] reads the same way, then matches the names to the GLB files).
+pub fn transforms_from_bytes(meta_path: &Path, bytes: &[u8]) -> Result<Vec<(String, Similarity)>> {
+    let meta = parse_metadata(meta_path, bytes)?;
+    transforms_of(meta_path, &meta)?
+        .iter()
+        .map(|(name, t)| {
+            parse_transform(t).map(|s| (name.clone(), s)).map_err(|m| {
+                Error::input(meta_path, format!("registration.transforms.{name}: {m}"))
+            })
+        })
+        .collect()
 }
 
 /// A transform entry: its `matrix` (preferred), else `scale` + `rotation` + `translation`.

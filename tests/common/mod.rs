@@ -1,6 +1,7 @@
 //! Helpers shared by the integration tests.
 #![allow(dead_code)]
 
+use std::fs;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
@@ -113,4 +114,85 @@ pub fn shared_scenes() -> Vec<PathBuf> {
     }
     v.sort();
     v
+}
+
+/// A broken scene is rejected: `export` and `validate` both exit 2 with one stderr line naming
+/// `culprit` and `problem`, print nothing on stdout, create no output folder, leave no temporary
+/// folder, and leave the inputs byte-identical.
+pub fn rejects(dir: &Path, culprit: &str, problem: &str) {
+    rejects_with(dir, &[], culprit, problem)
+}
+
+/// [`rejects`] with extra options; `scene` is a folder or a file (its folder is the input).
+pub fn rejects_with(scene: &Path, extra: &[&str], culprit: &str, problem: &str) {
+    let input = if scene.is_dir() {
+        scene
+    } else {
+        scene.parent().unwrap()
+    };
+    let before = snapshot(input);
+    let out = input.parent().unwrap().join("never");
+    let out_s = out.to_str().unwrap();
+    for cmd in ["export", "validate"] {
+        let mut args = vec![cmd, scene.to_str().unwrap()];
+        if cmd == "export" {
+            args.extend(["-o", out_s]);
+        }
+        args.extend_from_slice(extra);
+        let (code, stdout, stderr) = run(&args);
+        assert_eq!(code, 2, "{cmd}: {stderr}");
+        assert!(stdout.is_empty(), "{cmd}: {stdout}");
+        let line = stderr.trim();
+        assert_eq!(line.lines().count(), 1, "{cmd}: one line: {line}");
+        assert!(
+            line.contains(culprit) && line.contains(problem),
+            "{cmd}: expected {culprit:?} and {problem:?} in: {line}"
+        );
+        assert!(!line.contains("panicked"), "{cmd}: {line}");
+        assert!(!out.exists(), "{cmd}: no output folder");
+        let leftovers: Vec<_> = fs::read_dir(input.parent().unwrap())
+            .unwrap()
+            .filter_map(|e| e.ok())
+            .filter(|e| e.file_name().to_string_lossy().starts_with(".interact3d"))
+            .collect();
+        assert!(
+            leftovers.is_empty(),
+            "{cmd}: temporary folders left: {leftovers:?}"
+        );
+        assert_eq!(before, snapshot(input), "{cmd}: inputs untouched");
+    }
+}
+
+/// Every file under `dir` (links not followed) with its bytes, sorted.
+pub fn snapshot(dir: &Path) -> Vec<(String, Vec<u8>)> {
+    let mut v: Vec<_> = walk(dir)
+        .into_iter()
+        .map(|p| {
+            let bytes = if p.is_symlink() {
+                fs::read_link(&p)
+                    .unwrap()
+                    .display()
+                    .to_string()
+                    .into_bytes()
+            } else {
+                fs::read(&p).unwrap()
+            };
+            (p.display().to_string(), bytes)
+        })
+        .collect();
+    v.sort();
+    v
+}
+
+fn walk(dir: &Path) -> Vec<PathBuf> {
+    let mut out = Vec::new();
+    for e in fs::read_dir(dir).unwrap().filter_map(|e| e.ok()) {
+        let p = e.path();
+        if p.is_dir() && !p.is_symlink() {
+            out.extend(walk(&p));
+        } else {
+            out.push(p);
+        }
+    }
+    out
 }
