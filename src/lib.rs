@@ -7,6 +7,7 @@
 //! [`export`] (MJCF, URDF) → [`metrics`] and [`physics`] (validation).
 
 pub mod batch;
+pub mod compose;
 pub mod body;
 pub mod decompose;
 pub mod error;
