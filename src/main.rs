@@ -160,6 +160,10 @@ struct ExportArgs {
     /// Start bodies at the composed pose even when validation passes (default: settled pose).
     #[arg(long)]
     keep_composed_pose: bool,
+    /// Remove slight interpenetration of the given poses first, moving each object as little
+    /// as possible (the collision-aware refinement of `compose`); listed in report.json warnings.
+    #[arg(long)]
+    fix_penetration: bool,
     #[command(flatten)]
     check: CheckArgs,
     /// Write JUnit XML of the validation to this file.
@@ -267,6 +271,7 @@ fn run(cli: Cli) -> Result<ExitCode, Error> {
                 },
                 validate: (!a.no_validate).then(|| a.check.options()),
                 keep_composed_pose: a.keep_composed_pose,
+                fix_penetration: a.fix_penetration,
                 ..Default::default()
             };
             let t = std::time::Instant::now();

@@ -4,7 +4,7 @@
 
 use super::cloud::Cloud;
 use super::features::{fpfh, match_features};
-use super::icp::{trimmed_icp, umeyama, IcpOptions};
+use super::icp::{trimmed_icp, umeyama, IcpOptions, Matcher};
 use super::kdtree::KdTree;
 use super::obb::{axis_permutations, Obb};
 use super::rng::Rng;
@@ -205,12 +205,12 @@ pub fn score(p: &Problem, t: &Similarity, colour: bool, probe_g: &[usize], probe
 pub fn best_hypothesis(
     p: &Problem,
     hyps: &[Similarity],
+    matcher: &Matcher,
     colour: bool,
     icp: &IcpOptions,
 ) -> Option<(Similarity, f64)> {
     use rayon::prelude::*;
-    let step_g = (p.guidance.len() / 500).max(1);
-    let g_short: Vec<P3> = p.guidance.points.iter().step_by(step_g).copied().collect();
+    let g_short = p.guidance.subsample(500);
     let probe_g: Vec<usize> = (0..p.guidance.len()).step_by((p.guidance.len() / 700).max(1)).collect();
     let probe_o: Vec<usize> = (0..p.object.len()).step_by((p.object.len() / 700).max(1)).collect();
     let short = IcpOptions {
@@ -220,7 +220,7 @@ pub fn best_hypothesis(
     let results: Vec<(Similarity, f64)> = hyps
         .par_iter()
         .map(|h| {
-            let (t, _) = trimmed_icp(&p.object.points, p.object_tree, &g_short, *h, &short);
+            let (t, _) = trimmed_icp(&p.object.points, matcher, &g_short, *h, &short);
             let s = score(p, &t, colour, &probe_g, &probe_o);
             (t, s)
         })

@@ -1,6 +1,7 @@
 //! Closed-form similarity (Umeyama 1991) with a bounded scale, and scale-aware trimmed ICP.
 
-use super::kdtree::KdTree;
+use super::cloud::Cloud;
+use super::kdtree::{KdTree, KdTreeN};
 use crate::mesh::{P3, V3};
 use crate::pose::Similarity;
 use nalgebra::{Matrix3, Rotation3, UnitQuaternion};
@@ -60,29 +61,73 @@ pub struct IcpOptions {
     pub tolerance: f64,
 }
 
+/// How ICP pairs a guidance point (mapped into the object frame) with an object sample.
+pub enum Matcher<'a> {
+    /// The nearest object sample.
+    Geometry(&'a KdTree),
+    /// The nearest in position + `weight` × colour (both clouds' colours gain-normalised):
+    /// on a symmetric shape the geometry is ambiguous and the print decides.
+    Colour {
+        tree: &'a KdTreeN<6>,
+        weight: f64,
+    },
+}
+
+impl<'a> Matcher<'a> {
+    /// The 6-d tree of `object` for [`Matcher::Colour`].
+    pub fn colour_tree(object: &Cloud, weight: f64) -> KdTreeN<6> {
+        KdTreeN::from_coords(
+            object
+                .points
+                .iter()
+                .zip(&object.colours)
+                .map(|(p, c)| [p.x, p.y, p.z, weight * c[0], weight * c[1], weight * c[2]])
+                .collect(),
+        )
+    }
+
+    fn nearest(&self, q: &P3, colour: &[f64; 3]) -> Option<(usize, f64)> {
+        match self {
+            Matcher::Geometry(t) => t.nearest(q),
+            Matcher::Colour { tree, weight } => tree.nearest_n(&[
+                q.x,
+                q.y,
+                q.z,
+                weight * colour[0],
+                weight * colour[1],
+                weight * colour[2],
+            ]),
+        }
+    }
+}
+
 /// Transform the object into the guidance points: for each guidance point the nearest object
 /// sample (the guidance part has holes, the object does not, so correspondences go from the
 /// guidance to the object), the worst `1 − keep` dropped, Umeyama on the rest, repeated.
-/// `object_tree` is built on `object` (object frame).
+/// Returns the pose and the RMS of the kept pairs (guidance units).
 pub fn trimmed_icp(
     object: &[P3],
-    object_tree: &KdTree,
-    guidance: &[P3],
+    matcher: &Matcher,
+    guidance: &Cloud,
     init: Similarity,
     o: &IcpOptions,
 ) -> (Similarity, f64) {
     let mut t = init;
     let mut rms = f64::INFINITY;
-    let mut pairs: Vec<(f64, usize, usize)> = Vec::with_capacity(guidance.len());
-    let mut xs = Vec::with_capacity(guidance.len());
-    let mut ys = Vec::with_capacity(guidance.len());
+    let n = guidance.len();
+    let mut pairs: Vec<(f64, usize, usize)> = Vec::with_capacity(n);
+    let mut xs = Vec::with_capacity(n);
+    let mut ys = Vec::with_capacity(n);
     for _ in 0..o.iterations {
         let inv = t.matrix().try_inverse().unwrap_or_else(nalgebra::Matrix4::identity);
         pairs.clear();
-        for (gi, g) in guidance.iter().enumerate() {
-            let q = inv.transform_point(g);
-            if let Some((oi, d2)) = object_tree.nearest(&q) {
-                pairs.push((d2, gi, oi));
+        for gi in 0..n {
+            let q = inv.transform_point(&guidance.points[gi]);
+            if let Some((oi, _)) = matcher.nearest(&q, &guidance.colours[gi]) {
+                // Trim by the geometric distance only: with colour-aware matching the pairs
+                // whose colours disagree are the ones that turn a symmetric shape the right way;
+                // they are not outliers.
+                pairs.push(((q - object[oi]).norm_squared(), gi, oi));
             }
         }
         if pairs.len() < 3 {
@@ -94,9 +139,9 @@ pub fn trimmed_icp(
         ys.clear();
         for &(_, gi, oi) in &pairs[..k] {
             xs.push(object[oi]);
-            ys.push(guidance[gi]);
+            ys.push(guidance.points[gi]);
         }
-        rms = (pairs[..k].iter().map(|p| p.0).sum::<f64>() / k as f64).sqrt() * t.scale;
+        rms = (xs.iter().zip(&ys).map(|(x, y)| (t.matrix().transform_point(x) - y).norm_squared()).sum::<f64>() / k as f64).sqrt();
         let Some(next) = umeyama(&xs, &ys, o.scale_lo, o.scale_hi) else {
             break;
         };
@@ -155,15 +200,16 @@ mod tests {
             rotation: UnitQuaternion::from_euler_angles(0.3, 0.2, -0.4),
             translation: V3::new(1.0, 2.0, 3.0),
         };
-        let mut g: Vec<P3> = crate::compose::cloud::Cloud::sample(&vis, 1000, 2)
-            .points
-            .iter()
-            .filter(|p| p.x < 0.3) // a hole: part of the surface missing
-            .map(|p| truth.matrix().transform_point(p))
-            .collect();
-        for _ in 0..60 {
-            g.push(P3::new(rng.range(0.0, 3.0), rng.range(1.0, 4.0), rng.range(2.0, 5.0)));
+        let mut g = Cloud::default();
+        for p in Cloud::sample(&vis, 1000, 2).points.iter().filter(|p| p.x < 0.3) {
+            // a hole: part of the surface missing
+            g.points.push(truth.matrix().transform_point(p));
         }
+        for _ in 0..60 {
+            g.points.push(P3::new(rng.range(0.0, 3.0), rng.range(1.0, 4.0), rng.range(2.0, 5.0)));
+        }
+        g.colours = vec![[0.5; 3]; g.points.len()];
+        g.normals = vec![V3::z(); g.points.len()];
         let init = Similarity {
             scale: 1.9,
             rotation: UnitQuaternion::from_euler_angles(0.4, 0.1, -0.3),
@@ -177,7 +223,7 @@ mod tests {
             scale_hi: 2.5,
             tolerance: 1e-7,
         };
-        let (t, _) = trimmed_icp(&obj.points, &tree, &g, init, &o);
+        let (t, _) = trimmed_icp(&obj.points, &Matcher::Geometry(&tree), &g, init, &o);
         assert!(t.rotation.angle_to(&truth.rotation).to_degrees() < 1.0);
         assert!((t.scale - 2.0).abs() < 0.03, "{}", t.scale);
         assert!((t.translation - truth.translation).norm() < 0.03);

@@ -1,14 +1,15 @@
-//! A static 3-d tree over points: nearest neighbour and radius queries. Small and exact; built
-//! once per cloud (median splits), queried many times by ICP, scoring and features.
+//! A static k-d tree over points of `D` coordinates (3: positions; 6: positions + weighted
+//! colour, for colour-aware correspondences): nearest neighbour and radius queries. Small and
+//! exact; built once per cloud (median splits), queried many times by ICP, scoring and features.
 
 use crate::mesh::P3;
 
 const LEAF: usize = 12;
 
 #[derive(Clone, Debug)]
-struct Node {
-    lo: [f64; 3],
-    hi: [f64; 3],
+struct Node<const D: usize> {
+    lo: [f64; D],
+    hi: [f64; D],
     /// Leaf: range into `idx`; inner: children in `left`, `left + 1`.
     start: u32,
     end: u32,
@@ -17,19 +18,26 @@ struct Node {
 
 /// A k-d tree over a fixed set of points.
 #[derive(Clone, Debug)]
-pub struct KdTree {
-    pts: Vec<[f64; 3]>,
+pub struct KdTreeN<const D: usize> {
+    pts: Vec<[f64; D]>,
     idx: Vec<u32>,
-    nodes: Vec<Node>,
+    nodes: Vec<Node<D>>,
 }
 
-fn d2(a: &[f64; 3], b: &[f64; 3]) -> f64 {
-    (a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2) + (a[2] - b[2]).powi(2)
-}
+/// The 3-d tree of positions.
+pub type KdTree = KdTreeN<3>;
 
-fn box_d2(n: &Node, p: &[f64; 3]) -> f64 {
+fn d2<const D: usize>(a: &[f64; D], b: &[f64; D]) -> f64 {
     let mut s = 0.0;
-    for k in 0..3 {
+    for k in 0..D {
+        s += (a[k] - b[k]).powi(2);
+    }
+    s
+}
+
+fn box_d2<const D: usize>(n: &Node<D>, p: &[f64; D]) -> f64 {
+    let mut s = 0.0;
+    for k in 0..D {
         let d = (n.lo[k] - p[k]).max(0.0).max(p[k] - n.hi[k]);
         s += d * d;
     }
@@ -38,16 +46,31 @@ fn box_d2(n: &Node, p: &[f64; 3]) -> f64 {
 
 impl KdTree {
     pub fn new(points: &[P3]) -> KdTree {
-        let pts: Vec<[f64; 3]> = points.iter().map(|p| [p.x, p.y, p.z]).collect();
-        let mut t = KdTree {
+        KdTreeN::from_coords(points.iter().map(|p| [p.x, p.y, p.z]).collect())
+    }
+
+    /// Index and squared distance of the nearest point (`None` for an empty tree).
+    pub fn nearest(&self, p: &P3) -> Option<(usize, f64)> {
+        self.nearest_n(&[p.x, p.y, p.z])
+    }
+
+    /// Indices of all points within `r` of `p`, ascending.
+    pub fn within(&self, p: &P3, r: f64, out: &mut Vec<usize>) {
+        self.within_n(&[p.x, p.y, p.z], r, out)
+    }
+}
+
+impl<const D: usize> KdTreeN<D> {
+    pub fn from_coords(pts: Vec<[f64; D]>) -> KdTreeN<D> {
+        let mut t = KdTreeN {
             idx: (0..pts.len() as u32).collect(),
             pts,
             nodes: Vec::new(),
         };
         if !t.pts.is_empty() {
             t.nodes.push(Node {
-                lo: [0.0; 3],
-                hi: [0.0; 3],
+                lo: [0.0; D],
+                hi: [0.0; D],
                 start: 0,
                 end: 0,
                 left: 0,
@@ -66,11 +89,11 @@ impl KdTree {
     }
 
     fn build(&mut self, node: usize, start: usize, end: usize) {
-        let mut lo = [f64::INFINITY; 3];
-        let mut hi = [f64::NEG_INFINITY; 3];
+        let mut lo = [f64::INFINITY; D];
+        let mut hi = [f64::NEG_INFINITY; D];
         for &i in &self.idx[start..end] {
             let p = self.pts[i as usize];
-            for k in 0..3 {
+            for k in 0..D {
                 lo[k] = lo[k].min(p[k]);
                 hi[k] = hi[k].max(p[k]);
             }
@@ -83,7 +106,7 @@ impl KdTree {
             self.nodes[node].left = 0;
             return;
         }
-        let axis = (0..3)
+        let axis = (0..D)
             .max_by(|&a, &b| (hi[a] - lo[a]).total_cmp(&(hi[b] - lo[b])))
             .unwrap();
         let mid = (start + end) / 2;
@@ -103,11 +126,11 @@ impl KdTree {
     }
 
     /// Index and squared distance of the nearest point (`None` for an empty tree).
-    pub fn nearest(&self, p: &P3) -> Option<(usize, f64)> {
+    pub fn nearest_n(&self, q: &[f64; D]) -> Option<(usize, f64)> {
         if self.pts.is_empty() {
             return None;
         }
-        let q = [p.x, p.y, p.z];
+        let q = *q;
         let mut best = (usize::MAX, f64::INFINITY);
         let mut stack: Vec<(u32, f64)> = Vec::with_capacity(64);
         stack.push((0, box_d2(&self.nodes[0], &q)));
@@ -140,13 +163,13 @@ impl KdTree {
         Some(best)
     }
 
-    /// Indices of all points within `r` of `p`, ascending.
-    pub fn within(&self, p: &P3, r: f64, out: &mut Vec<usize>) {
+    /// Indices of all points within `r` of `q`, ascending.
+    pub fn within_n(&self, q: &[f64; D], r: f64, out: &mut Vec<usize>) {
         out.clear();
         if self.pts.is_empty() {
             return;
         }
-        let q = [p.x, p.y, p.z];
+        let q = *q;
         let r2 = r * r;
         let mut stack = vec![0u32];
         while let Some(n) = stack.pop() {

@@ -36,6 +36,10 @@ use crate::pose::Similarity;
 use cloud::Cloud;
 use global::{best_hypothesis, FpfhRansac, GlobalRegistration, ObbHypotheses, Problem};
 use icp::{trimmed_icp, IcpOptions};
+
+/// Weight of a unit of (gain-normalised) colour difference in colour-aware correspondences, as a
+/// fraction of the object's diagonal.
+pub const COLOUR_WEIGHT: f64 = 0.1;
 use kdtree::KdTree;
 use obb::Obb;
 use refine::{refine, RefineOptions, Refined, Target};
@@ -277,26 +281,31 @@ fn register(
         }
     };
     let n_hyp = hyps.len();
+    let colour_tree;
+    let matcher = if use_colour {
+        colour_tree = icp::Matcher::colour_tree(object, COLOUR_WEIGHT * object.diagonal());
+        icp::Matcher::Colour {
+            tree: &colour_tree,
+            weight: COLOUR_WEIGHT * object.diagonal(),
+        }
+    } else {
+        icp::Matcher::Geometry(&object_tree)
+    };
     let init = if hyps.len() == 1 {
         hyps[0]
     } else {
-        best_hypothesis(&p, &hyps, use_colour, &icp)
+        best_hypothesis(&p, &hyps, &matcher, use_colour, &icp)
             .map(|(t, _)| t)
             .unwrap_or(hyps[0])
     };
-    let g_icp: Vec<P3> = guidance
-        .points
-        .iter()
-        .step_by((guidance.len() / 1500).max(1))
-        .copied()
-        .collect();
-    let (t, rms) = trimmed_icp(&object.points, &object_tree, &g_icp, init, &icp);
+    let g_icp = guidance.subsample(1500);
+    let (t, rms) = trimmed_icp(&object.points, &matcher, &g_icp, init, &icp);
     let probe_g: Vec<usize> = (0..guidance.len()).step_by((guidance.len() / 700).max(1)).collect();
     let probe_o: Vec<usize> = (0..object.len()).step_by((object.len() / 700).max(1)).collect();
     let score = global::score(&p, &t, use_colour, &probe_g, &probe_o);
     (
         t,
-        format!("{stages}+trimmed_icp"),
+        format!("{stages}+trimmed_icp{}", if use_colour { "+colour" } else { "" }),
         scale0,
         score,
         rms,
@@ -408,4 +417,69 @@ pub fn compose(inputs: &[ObjectInput], o: &ComposeOptions) -> Result<Composition
         objects: results,
         scene_diagonal: unit,
     })
+}
+
+/// What [`fix_penetration`] did to one object.
+#[derive(Clone, Debug, Serialize)]
+pub struct FixReport {
+    pub name: String,
+    /// Largest penetration of the object's surface samples into the objects placed before it,
+    /// before and after (scene units).
+    pub penetration_before: f64,
+    pub penetration_after: f64,
+    /// Largest displacement of a surface sample (scene units).
+    pub moved: f64,
+}
+
+/// Remove slight interpenetration from a scene's given poses while keeping every object as
+/// close as possible to its pose: the collision-aware refinement (step 5) with the data term
+/// pulling each surface sample back to where the given pose put it. Objects are taken in order
+/// (fixed objects first, then by decreasing bounding-box volume); the first stays put and each
+/// next one is refined against all those before it. Objects that do not penetrate are untouched.
+pub fn fix_penetration(scene: &mut crate::scene::Scene, o: &RefineOptions) -> Vec<FixReport> {
+    let placed: Vec<Mesh> = scene
+        .objects
+        .iter()
+        .map(|ob| ob.visual.geometry().transformed(&ob.pose.matrix()))
+        .collect();
+    let vol = |m: &Mesh| m.aabb().map(|b| b.extents().product()).unwrap_or(0.0);
+    let mut order: Vec<usize> = (0..placed.len()).collect();
+    order.sort_by(|&a, &b| {
+        scene.objects[b]
+            .physical
+            .fixed
+            .cmp(&scene.objects[a].physical.fixed)
+            .then(vol(&placed[b]).total_cmp(&vol(&placed[a])))
+            .then(a.cmp(&b))
+    });
+    let unit = placed
+        .iter()
+        .filter_map(|m| m.aabb())
+        .reduce(|a, b| a.union(&b))
+        .map(|b| b.diagonal())
+        .unwrap_or(1.0);
+    let mut field = AnchorField::new(&[], 40);
+    let mut out = Vec::new();
+    for (rank, &i) in order.iter().enumerate() {
+        if rank > 0 {
+            let ob = &scene.objects[i];
+            let pts = Cloud::sample(&ob.visual, 1500, 0x5EED).points;
+            let r = refine(&pts, &Target::InitialPose, ob.pose, &field, unit, o);
+            let report = FixReport {
+                name: ob.name.clone(),
+                penetration_before: r.penetration_before,
+                penetration_after: if r.penetration_before > 0.0 { r.penetration_after } else { 0.0 },
+                moved: if r.penetration_before > 0.0 { r.moved } else { 0.0 },
+            };
+            if r.penetration_before > 0.0 {
+                scene.objects[i].pose = r.transform;
+            }
+            out.push(report);
+        }
+        if rank + 1 < order.len() {
+            let ob = &scene.objects[i];
+            field.push(&ob.visual.geometry().transformed(&ob.pose.matrix()), 40);
+        }
+    }
+    out
 }

@@ -36,16 +36,19 @@ impl Obb {
             let c = -axes.column(2);
             axes.set_column(2, &c);
         }
-        let mut lo = V3::repeat(f64::INFINITY);
-        let mut hi = V3::repeat(f64::NEG_INFINITY);
-        for p in points {
-            let q = axes.transpose() * (p.coords - mean);
-            lo = lo.inf(&q);
-            hi = hi.sup(&q);
-        }
-        if points.is_empty() {
-            lo = V3::zeros();
-            hi = V3::zeros();
+        // Extents between the 0.5th and 99.5th percentiles of the projections: a few stray
+        // points (a fused fragment of the neighbour, noise) do not stretch the box.
+        let mut lo = V3::zeros();
+        let mut hi = V3::zeros();
+        if !points.is_empty() {
+            for k in 0..3 {
+                let ax = axes.column(k).into_owned();
+                let mut proj: Vec<f64> = points.iter().map(|p| ax.dot(&(p.coords - mean))).collect();
+                proj.sort_by(f64::total_cmp);
+                let cut = proj.len() / 200;
+                lo[k] = proj[cut];
+                hi[k] = proj[proj.len() - 1 - cut];
+            }
         }
         let mid = (lo + hi) / 2.0;
         // Re-sort by extent (principal variance and extent order can differ).

@@ -273,18 +273,16 @@ pub fn make(objects: &[TruthObject], seed: u64, o: &SynthOptions) -> Synthetic {
                 for p in &other.parts {
                     let mut k = vec![false; p.triangles.len()];
                     for (ti, tr) in p.triangles.iter().enumerate() {
-                        if budget <= 0.0 {
-                            break;
-                        }
                         let v = tr.map(|q| p.positions[q as usize]);
                         let c = P3::from((v[0].coords + v[1].coords + v[2].coords) / 3.0);
                         if (c - cpt).norm() > 0.3 * d_i {
                             continue;
                         }
                         if let Some((_, d2)) = trees[i].nearest(&c) {
-                            if d2.sqrt() < o.fuse * d_i {
+                            let a = triangle_area(&v);
+                            if d2.sqrt() < o.fuse * d_i && a <= budget {
                                 k[ti] = true;
-                                budget -= triangle_area(&v);
+                                budget -= a;
                             }
                         }
                     }
@@ -377,28 +375,30 @@ pub fn errors(est: &Similarity, truth: &Similarity) -> (f64, f64, f64) {
     )
 }
 
-/// Whether the object placed by `est` looks the same as placed by `truth`: for 95% of its
-/// coloured surface samples, the nearest truth-placed sample is within 2% of the object's
-/// diagonal and of a similar colour. True for the symmetries a pose cannot observe (a plain
-/// sphere spun, a striped ball spun about its stripes' axis); false for a printed box upside down.
+/// Whether the object placed by `est` looks the same as placed by `truth`: for 90% of 2,000
+/// coloured surface samples placed by `est`, one of 40,000 samples placed by `truth` lies within
+/// 2% of the object's diagonal with a similar colour (the dense set keeps the share of pairs
+/// straddling a colour edge small). True for the symmetries a pose cannot observe (a plain
+/// sphere spun, a checkered bowl turned by one period); false for a printed box upside down.
 pub fn appearance_equivalent(visual: &VisualMesh, est: &Similarity, truth: &Similarity) -> bool {
-    let c = super::cloud::Cloud::sample(visual, 3000, 99);
-    let a = c.transformed(&est.matrix());
-    let b = c.transformed(&truth.matrix());
-    let tree = KdTree::new(&b.points);
+    let a = super::cloud::Cloud::sample(visual, 2000, 98).transformed(&est.matrix());
+    let b = super::cloud::Cloud::sample(visual, 40_000, 99).transformed(&truth.matrix());
     let tol = 0.02 * b.diagonal();
+    let tree = KdTree::new(&b.points);
+    let mut near = Vec::new();
     let good = a
         .points
         .iter()
         .zip(&a.colours)
         .filter(|(p, col)| {
-            tree.nearest(p).is_some_and(|(j, d2)| {
+            tree.within(p, tol, &mut near);
+            near.iter().any(|&j| {
                 let dc: f64 = (0..3).map(|k| (col[k] - b.colours[j][k]).powi(2)).sum::<f64>();
-                d2.sqrt() <= tol && dc.sqrt() < 0.2
+                dc.sqrt() < 0.2
             })
         })
         .count();
-    good as f64 >= 0.95 * a.len() as f64
+    good as f64 >= 0.9 * a.len() as f64
 }
 
 /// A texture whose colour is unique at every texel (a smooth gradient plus a diagonal wave), so
