@@ -170,7 +170,7 @@ fn main() {
         eprintln!("{:<36} done at {:6.1} s", case.name, t_all.elapsed().as_secs_f64());
     }
     for (sym, title) in [(0usize, "non-symmetric objects"), (1, "symmetric objects (boxes, book, can, die)")] {
-        println!("\n### {title}: {} objects × {seeds} seeds\n", rows[0][sym].n / seeds.max(1) as usize);
+        println!("\n#### {title}: {} objects × {seeds} seeds\n", rows[0][sym].n / seeds.max(1) as usize);
         println!("| method | success | median rot (°) | median trans (% diag) | median scale (%) | median R_volume | max R_volume | median max pen (mm) | max pen (mm) | time / object (s) |");
         println!("|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|");
         for (mi, m) in methods.iter().enumerate() {

@@ -21,6 +21,17 @@ fn compose_and_check(src: &Path, seed: u64, tmp: &Path) {
     let (code, _, err) = run(&["compose", sample.to_str().unwrap(), "-o", out.to_str().unwrap()]);
     assert_eq!(code, 0, "compose failed: {err}");
     assert_eq!(dir_listing(&sample), before, "the input folder was modified");
+    // Deterministic: a second run gives byte-identical output.
+    let out2 = tmp.join("out2");
+    let (code, _, err) = run(&["compose", sample.to_str().unwrap(), "-o", out2.to_str().unwrap()]);
+    assert_eq!(code, 0, "{err}");
+    for f in ["metadata.json", "scene.json"] {
+        assert_eq!(
+            std::fs::read(out.join(f)).unwrap(),
+            std::fs::read(out2.join(f)).unwrap(),
+            "{f} differs between two runs"
+        );
+    }
 
     let meta: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(out.join("metadata.json")).unwrap()).unwrap();
