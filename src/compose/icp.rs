@@ -86,7 +86,8 @@ impl<'a> Matcher<'a> {
         )
     }
 
-    fn nearest(&self, q: &P3, colour: &[f64; 3]) -> Option<(usize, f64)> {
+    /// The object sample paired with `q` (object frame) of colour `colour`.
+    pub fn nearest(&self, q: &P3, colour: &[f64; 3]) -> Option<(usize, f64)> {
         match self {
             Matcher::Geometry(t) => t.nearest(q),
             Matcher::Colour { tree, weight } => tree.nearest_n(&[

@@ -31,7 +31,7 @@ pub mod sdf;
 pub mod synth;
 
 use crate::error::{Error, Result};
-use crate::mesh::{Mesh, VisualMesh, P3};
+use crate::mesh::{Mesh, VisualMesh};
 use crate::pose::Similarity;
 use cloud::Cloud;
 use global::{best_hypothesis, FpfhRansac, GlobalRegistration, ObbHypotheses, Problem};
@@ -362,26 +362,26 @@ pub fn compose(inputs: &[ObjectInput], o: &ComposeOptions) -> Result<Composition
         let mut refinement = None;
         if rank > 0 && o.method.refines() {
             if let Some(f) = &field {
-                let tree = KdTree::new(&object.points);
-                let g: Vec<P3> = guidance
-                    .points
-                    .iter()
-                    .step_by((guidance.len() / 600).max(1))
-                    .copied()
-                    .collect();
-                let pts: Vec<P3> = object
-                    .points
-                    .iter()
-                    .step_by((object.len() / 1500).max(1))
-                    .copied()
-                    .collect();
-                let sub_tree = KdTree::new(&pts);
-                let _ = tree;
+                let g = guidance.subsample(600);
+                let sub = object.subsample(700);
+                let sub_tree = KdTree::new(&sub.points);
+                let colour_sub;
+                let matcher = if colour_used {
+                    let w = COLOUR_WEIGHT * object.diagonal();
+                    colour_sub = icp::Matcher::colour_tree(&sub, w);
+                    icp::Matcher::Colour {
+                        tree: &colour_sub,
+                        weight: w,
+                    }
+                } else {
+                    icp::Matcher::Geometry(&sub_tree)
+                };
                 let r = refine(
-                    &pts,
+                    &sub.points,
                     &Target::Guidance {
-                        points: &g,
-                        object_tree: &sub_tree,
+                        points: &g.points,
+                        colours: &g.colours,
+                        matcher: &matcher,
                         keep: 0.8,
                     },
                     t,
@@ -396,8 +396,8 @@ pub fn compose(inputs: &[ObjectInput], o: &ComposeOptions) -> Result<Composition
         }
         if o.method.refines() && rank + 1 < order.len() {
             let placed: Mesh = inp.visual.geometry().transformed(&t.matrix());
-            let fld = field.get_or_insert_with(|| AnchorField::new(&[], 40));
-            fld.push(&placed, 40);
+            let fld = field.get_or_insert_with(|| AnchorField::new(&[], 32));
+            fld.push(&placed, 32);
         }
         results.push(ObjectResult {
             name: inp.name.clone(),

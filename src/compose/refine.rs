@@ -15,7 +15,7 @@
 //! penetration is still above the tolerance after k_max stages, β keeps doubling (a penalty
 //! continuation) until it is below, which converges to the closest non-penetrating pose.
 
-use super::kdtree::KdTree;
+use super::icp::Matcher;
 use super::sdf::AnchorField;
 use crate::mesh::{P3, V3};
 use crate::pose::Similarity;
@@ -23,11 +23,13 @@ use nalgebra::{Matrix3, Matrix6, UnitQuaternion, Vector6};
 
 /// Where the data term pulls each object point.
 pub enum Target<'a> {
-    /// Towards the guidance part: each guidance point's nearest object sample (trimmed),
-    /// re-chosen every stage. `object_tree` is built on the object points given to `refine`.
+    /// Towards the guidance part: each guidance point's object sample (nearest, or nearest in
+    /// position + colour, as in ICP; trimmed by distance), re-chosen every stage. `matcher` is
+    /// built on the object points given to `refine`; `colours` are the guidance points'.
     Guidance {
         points: &'a [P3],
-        object_tree: &'a KdTree,
+        colours: &'a [[f64; 3]],
+        matcher: &'a Matcher<'a>,
         keep: f64,
     },
     /// Towards the object's initial placement (fix penetration while moving as little as possible).
@@ -130,15 +132,18 @@ pub fn refine(
         match target {
             Target::Guidance {
                 points: g,
-                object_tree,
+                colours,
+                matcher,
                 keep,
             } => {
                 let inv = t.matrix().try_inverse().unwrap();
                 let mut c: Vec<(f64, usize, P3)> = g
                     .iter()
-                    .filter_map(|gp| {
-                        let (oi, d2) = object_tree.nearest(&inv.transform_point(gp))?;
-                        Some((d2, oi, *gp))
+                    .zip(colours.iter())
+                    .filter_map(|(gp, col)| {
+                        let q = inv.transform_point(gp);
+                        let (oi, _) = matcher.nearest(&q, col)?;
+                        Some(((q - points[oi]).norm_squared(), oi, *gp))
                     })
                     .collect();
                 c.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
