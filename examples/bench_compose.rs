@@ -75,7 +75,12 @@ fn main() {
             .unwrap()
             .flatten()
             .filter(|e| e.path().is_dir())
-            .flat_map(|c| std::fs::read_dir(c.path()).unwrap().flatten().map(|e| e.path()))
+            .flat_map(|c| {
+                std::fs::read_dir(c.path())
+                    .unwrap()
+                    .flatten()
+                    .map(|e| e.path())
+            })
             .filter(|p| p.join("metadata.json").is_file())
             .collect();
         dirs.sort();
@@ -149,7 +154,10 @@ fn main() {
                     }
                     placed.push(inp.visual.geometry().transformed(&est.matrix()));
                 }
-                let prep: Vec<Prepared> = placed.iter().map(|p| Prepared::new(Solid::Mesh(p))).collect();
+                let prep: Vec<Prepared> = placed
+                    .iter()
+                    .map(|p| Prepared::new(Solid::Mesh(p)))
+                    .collect();
                 let mopts = MetricsOptions {
                     points: 100_000,
                     ..Default::default()
@@ -167,10 +175,20 @@ fn main() {
                 row.pen_mm.push(1000.0 * pen / s.frame.scale);
             }
         }
-        eprintln!("{:<36} done at {:6.1} s", case.name, t_all.elapsed().as_secs_f64());
+        eprintln!(
+            "{:<36} done at {:6.1} s",
+            case.name,
+            t_all.elapsed().as_secs_f64()
+        );
     }
-    for (sym, title) in [(0usize, "non-symmetric objects"), (1, "symmetric objects (boxes, book, can, die)")] {
-        println!("\n#### {title}: {} objects × {seeds} seeds\n", rows[0][sym].n / seeds.max(1) as usize);
+    for (sym, title) in [
+        (0usize, "non-symmetric objects"),
+        (1, "symmetric objects (boxes, book, can, die)"),
+    ] {
+        println!(
+            "\n#### {title}: {} objects × {seeds} seeds\n",
+            rows[0][sym].n / seeds.max(1) as usize
+        );
         println!("| method | success | median rot (°) | median trans (% diag) | median scale (%) | median R_volume | max R_volume | median max pen (mm) | max pen (mm) | time / object (s) |");
         println!("|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|");
         for (mi, m) in methods.iter().enumerate() {

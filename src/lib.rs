@@ -7,8 +7,8 @@
 //! [`export`] (MJCF, URDF) → [`metrics`] and [`physics`] (validation).
 
 pub mod batch;
-pub mod compose;
 pub mod body;
+pub mod compose;
 pub mod decompose;
 pub mod error;
 pub mod export;

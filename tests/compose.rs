@@ -18,12 +18,26 @@ fn compose_and_check(src: &Path, seed: u64, tmp: &Path) {
     synth::write_sample(&s, Some(src), &sample).unwrap();
     let before: Vec<(String, u64)> = dir_listing(&sample);
     let out = tmp.join("out");
-    let (code, _, err) = run(&["compose", sample.to_str().unwrap(), "-o", out.to_str().unwrap()]);
+    let (code, _, err) = run(&[
+        "compose",
+        sample.to_str().unwrap(),
+        "-o",
+        out.to_str().unwrap(),
+    ]);
     assert_eq!(code, 0, "compose failed: {err}");
-    assert_eq!(dir_listing(&sample), before, "the input folder was modified");
+    assert_eq!(
+        dir_listing(&sample),
+        before,
+        "the input folder was modified"
+    );
     // Deterministic: a second run gives byte-identical output.
     let out2 = tmp.join("out2");
-    let (code, _, err) = run(&["compose", sample.to_str().unwrap(), "-o", out2.to_str().unwrap()]);
+    let (code, _, err) = run(&[
+        "compose",
+        sample.to_str().unwrap(),
+        "-o",
+        out2.to_str().unwrap(),
+    ]);
     assert_eq!(code, 0, "{err}");
     for f in ["metadata.json", "scene.json"] {
         assert_eq!(
@@ -37,7 +51,11 @@ fn compose_and_check(src: &Path, seed: u64, tmp: &Path) {
         serde_json::from_str(&std::fs::read_to_string(out.join("metadata.json")).unwrap()).unwrap();
     let reg = &meta["registration"];
     assert!(reg["anchor_object"].is_string());
-    assert!(reg["penetration_check"]["max_r_volume"].as_f64().unwrap() <= 1e-4, "{}", reg["penetration_check"]);
+    assert!(
+        reg["penetration_check"]["max_r_volume"].as_f64().unwrap() <= 1e-4,
+        "{}",
+        reg["penetration_check"]
+    );
     let diag = s
         .inputs
         .iter()
@@ -81,7 +99,12 @@ fn dir_listing(d: &Path) -> Vec<(String, u64)> {
     let mut v: Vec<(String, u64)> = std::fs::read_dir(d)
         .unwrap()
         .flatten()
-        .map(|e| (e.file_name().to_string_lossy().into_owned(), e.metadata().unwrap().len()))
+        .map(|e| {
+            (
+                e.file_name().to_string_lossy().into_owned(),
+                e.metadata().unwrap().len(),
+            )
+        })
         .collect();
     v.sort();
     v
@@ -111,10 +134,22 @@ fn missing_guidance_is_a_one_line_input_error() {
     let tmp = tempfile::tempdir().unwrap();
     let sample = tmp.path().join("s");
     std::fs::create_dir(&sample).unwrap();
-    std::fs::copy(root().join("fixtures/ball_bowl/object_a.glb"), sample.join("object_a.glb")).unwrap();
-    let (code, _, err) = run(&["compose", sample.to_str().unwrap(), "-o", tmp.path().join("o").to_str().unwrap()]);
+    std::fs::copy(
+        root().join("fixtures/ball_bowl/object_a.glb"),
+        sample.join("object_a.glb"),
+    )
+    .unwrap();
+    let (code, _, err) = run(&[
+        "compose",
+        sample.to_str().unwrap(),
+        "-o",
+        tmp.path().join("o").to_str().unwrap(),
+    ]);
     assert_eq!(code, 2);
-    assert!(err.contains("guidance_object_a.glb") && err.trim().lines().count() == 1, "{err}");
+    assert!(
+        err.contains("guidance_object_a.glb") && err.trim().lines().count() == 1,
+        "{err}"
+    );
     assert!(!tmp.path().join("o").exists());
 }
 
@@ -131,7 +166,10 @@ fn export_fix_penetration_lifts_the_sunk_box_by_its_overlap() {
     let report: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(out.join("report.json")).unwrap()).unwrap();
     let warnings = report["warnings"].to_string();
-    assert!(warnings.contains("--fix-penetration moved top"), "{warnings}");
+    assert!(
+        warnings.contains("--fix-penetration moved top"),
+        "{warnings}"
+    );
     // The minimal correction is the 3 mm overlap plus the ε clearance (0.2% of the 0.37 m
     // scene diagonal, 0.7 mm): a move of 3–4.2 mm, after which the scene passes.
     let moved: f64 = warnings

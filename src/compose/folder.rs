@@ -22,7 +22,10 @@ pub struct Sample {
 /// Read a sample folder: every `object_*.glb` needs its `guidance_object_*.glb` and vice versa.
 pub fn read_sample(dir: &Path, limits: &Limits) -> Result<Sample> {
     if !dir.is_dir() {
-        return Err(Error::input(dir, "not a folder (expected a sample folder with object_*.glb and guidance_object_*.glb)"));
+        return Err(Error::input(
+            dir,
+            "not a folder (expected a sample folder with object_*.glb and guidance_object_*.glb)",
+        ));
     }
     let mut objects = Vec::new();
     let mut guides = Vec::new();
@@ -101,7 +104,10 @@ pub fn penetration_check(sample: &Sample, comp: &Composition, points: usize) -> 
             Some((i.name.clone(), i.visual.geometry().transformed(&t.matrix())))
         })
         .collect();
-    let prepared: Vec<Prepared> = placed.iter().map(|(_, m)| Prepared::new(Solid::Mesh(m))).collect();
+    let prepared: Vec<Prepared> = placed
+        .iter()
+        .map(|(_, m)| Prepared::new(Solid::Mesh(m)))
+        .collect();
     let opts = MetricsOptions {
         points,
         ..Default::default()
@@ -132,11 +138,18 @@ pub fn penetration_check(sample: &Sample, comp: &Composition, points: usize) -> 
 }
 
 fn rows(m: &nalgebra::Matrix4<f64>) -> Vec<Vec<f64>> {
-    (0..4).map(|i| (0..4).map(|j| m[(i, j)]).collect()).collect()
+    (0..4)
+        .map(|i| (0..4).map(|j| m[(i, j)]).collect())
+        .collect()
 }
 
 /// The `registration` section in the reference code's shape.
-pub fn registration_json(sample: &Sample, comp: &Composition, check: &Value, o: &ComposeOptions) -> Value {
+pub fn registration_json(
+    sample: &Sample,
+    comp: &Composition,
+    check: &Value,
+    o: &ComposeOptions,
+) -> Value {
     let mut transforms = Map::new();
     for i in &sample.inputs {
         let Some(r) = comp.get(&i.name) else { continue };
@@ -154,9 +167,17 @@ pub fn registration_json(sample: &Sample, comp: &Composition, check: &Value, o: 
             }),
         );
     }
-    let remaining: Vec<&str> = comp.objects.iter().skip(1).map(|r| r.name.as_str()).collect();
+    let remaining: Vec<&str> = comp
+        .objects
+        .iter()
+        .skip(1)
+        .map(|r| r.name.as_str())
+        .collect();
     let confident = comp.objects.iter().all(|r| r.score >= 0.6);
-    let passed = check.get("passed").and_then(Value::as_bool).unwrap_or(false);
+    let passed = check
+        .get("passed")
+        .and_then(Value::as_bool)
+        .unwrap_or(false);
     let mut reg = Map::new();
     reg.insert("anchor_object".into(), json!(comp.anchor));
     if remaining.len() == 1 {
@@ -166,7 +187,11 @@ pub fn registration_json(sample: &Sample, comp: &Composition, check: &Value, o: 
     }
     reg.insert(
         "status".into(),
-        json!(if confident && passed { "success" } else { "needs_review" }),
+        json!(if confident && passed {
+            "success"
+        } else {
+            "needs_review"
+        }),
     );
     reg.insert("transforms".into(), Value::Object(transforms));
     reg.insert("penetration_check".into(), check.clone());
@@ -195,14 +220,19 @@ pub fn compose_folder(
 ) -> Result<(Composition, Value)> {
     if let (Ok(a), Ok(b)) = (sample_dir.canonicalize(), out.canonicalize()) {
         if a == b {
-            return Err(Error::Usage("OUT must differ from SAMPLE (the input folder is never modified)".into()));
+            return Err(Error::Usage(
+                "OUT must differ from SAMPLE (the input folder is never modified)".into(),
+            ));
         }
     }
     let sample = read_sample(sample_dir, limits)?;
     let comp = compose(&sample.inputs, o)?;
     let check = penetration_check(&sample, &comp, 200_000);
     let mut meta = sample.metadata.clone();
-    meta.insert("registration".into(), registration_json(&sample, &comp, &check, o));
+    meta.insert(
+        "registration".into(),
+        registration_json(&sample, &comp, &check, o),
+    );
     let labels = meta.get("analysis").cloned();
     let manifest = Manifest {
         format: crate::scene::manifest::FORMAT.into(),
@@ -243,10 +273,17 @@ pub fn compose_folder(
     crate::fsutil::write_dir_atomically(out, force, |tmp| {
         for i in &sample.inputs {
             let f = format!("{}.glb", i.name);
-            std::fs::copy(sample.dir.join(&f), tmp.join(&f)).map_err(|e| Error::io(sample.dir.join(&f), e))?;
+            std::fs::copy(sample.dir.join(&f), tmp.join(&f))
+                .map_err(|e| Error::io(sample.dir.join(&f), e))?;
         }
-        crate::fsutil::write(&tmp.join("metadata.json"), &crate::fsutil::json_bytes(&Value::Object(meta.clone()))?)?;
-        crate::fsutil::write(&tmp.join("scene.json"), &crate::fsutil::json_bytes(&manifest)?)?;
+        crate::fsutil::write(
+            &tmp.join("metadata.json"),
+            &crate::fsutil::json_bytes(&Value::Object(meta.clone()))?,
+        )?;
+        crate::fsutil::write(
+            &tmp.join("scene.json"),
+            &crate::fsutil::json_bytes(&manifest)?,
+        )?;
         Ok(())
     })?;
     Ok((comp, check))

@@ -137,7 +137,9 @@ impl GlobalRegistration for FpfhRansac {
             let m = t.matrix();
             let inliers = corr
                 .iter()
-                .filter(|&&(i, j)| (m.transform_point(&fo.points[i]) - fg.points[j]).norm_squared() < inlier_d2)
+                .filter(|&&(i, j)| {
+                    (m.transform_point(&fo.points[i]) - fg.points[j]).norm_squared() < inlier_d2
+                })
                 .count();
             if inliers < 3 {
                 continue;
@@ -168,7 +170,13 @@ impl GlobalRegistration for FpfhRansac {
 /// How well a pose explains the guidance: the fraction of guidance points with an object point
 /// within `tau` (colour-weighted when `colour`), plus half the fraction of object points with a
 /// guidance point within `tau` (penalises poses that push the object where the guidance is empty).
-pub fn score(p: &Problem, t: &Similarity, colour: bool, probe_g: &[usize], probe_o: &[usize]) -> f64 {
+pub fn score(
+    p: &Problem,
+    t: &Similarity,
+    colour: bool,
+    probe_g: &[usize],
+    probe_o: &[usize],
+) -> f64 {
     let tau = 0.02 * p.guidance_diagonal();
     let m = t.matrix();
     let inv = m.try_inverse().unwrap_or_else(nalgebra::Matrix4::identity);
@@ -211,8 +219,12 @@ pub fn best_hypothesis(
 ) -> Option<(Similarity, f64)> {
     use rayon::prelude::*;
     let g_short = p.guidance.subsample(500);
-    let probe_g: Vec<usize> = (0..p.guidance.len()).step_by((p.guidance.len() / 700).max(1)).collect();
-    let probe_o: Vec<usize> = (0..p.object.len()).step_by((p.object.len() / 700).max(1)).collect();
+    let probe_g: Vec<usize> = (0..p.guidance.len())
+        .step_by((p.guidance.len() / 700).max(1))
+        .collect();
+    let probe_o: Vec<usize> = (0..p.object.len())
+        .step_by((p.object.len() / 700).max(1))
+        .collect();
     let short = IcpOptions {
         iterations: 20,
         ..*icp

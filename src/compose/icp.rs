@@ -67,10 +67,7 @@ pub enum Matcher<'a> {
     Geometry(&'a KdTree),
     /// The nearest in position + `weight` × colour (both clouds' colours gain-normalised):
     /// on a symmetric shape the geometry is ambiguous and the print decides.
-    Colour {
-        tree: &'a KdTreeN<6>,
-        weight: f64,
-    },
+    Colour { tree: &'a KdTreeN<6>, weight: f64 },
 }
 
 impl<'a> Matcher<'a> {
@@ -120,7 +117,10 @@ pub fn trimmed_icp(
     let mut xs = Vec::with_capacity(n);
     let mut ys = Vec::with_capacity(n);
     for _ in 0..o.iterations {
-        let inv = t.matrix().try_inverse().unwrap_or_else(nalgebra::Matrix4::identity);
+        let inv = t
+            .matrix()
+            .try_inverse()
+            .unwrap_or_else(nalgebra::Matrix4::identity);
         pairs.clear();
         for gi in 0..n {
             let q = inv.transform_point(&guidance.points[gi]);
@@ -142,7 +142,13 @@ pub fn trimmed_icp(
             xs.push(object[oi]);
             ys.push(guidance.points[gi]);
         }
-        rms = (xs.iter().zip(&ys).map(|(x, y)| (t.matrix().transform_point(x) - y).norm_squared()).sum::<f64>() / k as f64).sqrt();
+        rms = (xs
+            .iter()
+            .zip(&ys)
+            .map(|(x, y)| (t.matrix().transform_point(x) - y).norm_squared())
+            .sum::<f64>()
+            / k as f64)
+            .sqrt();
         let Some(next) = umeyama(&xs, &ys, o.scale_lo, o.scale_hi) else {
             break;
         };
@@ -175,7 +181,10 @@ mod tests {
         let x: Vec<P3> = (0..50)
             .map(|_| P3::new(rng.normal(), rng.normal(), rng.normal()))
             .collect();
-        let y: Vec<P3> = x.iter().map(|p| truth.matrix().transform_point(p)).collect();
+        let y: Vec<P3> = x
+            .iter()
+            .map(|p| truth.matrix().transform_point(p))
+            .collect();
         let s = umeyama(&x, &y, 1e-6, 1e6).unwrap();
         assert!((s.scale - truth.scale).abs() < 1e-12);
         assert!(s.rotation.angle_to(&truth.rotation) < 1e-9);
@@ -202,12 +211,20 @@ mod tests {
             translation: V3::new(1.0, 2.0, 3.0),
         };
         let mut g = Cloud::default();
-        for p in Cloud::sample(&vis, 1000, 2).points.iter().filter(|p| p.x < 0.3) {
+        for p in Cloud::sample(&vis, 1000, 2)
+            .points
+            .iter()
+            .filter(|p| p.x < 0.3)
+        {
             // a hole: part of the surface missing
             g.points.push(truth.matrix().transform_point(p));
         }
         for _ in 0..60 {
-            g.points.push(P3::new(rng.range(0.0, 3.0), rng.range(1.0, 4.0), rng.range(2.0, 5.0)));
+            g.points.push(P3::new(
+                rng.range(0.0, 3.0),
+                rng.range(1.0, 4.0),
+                rng.range(2.0, 5.0),
+            ));
         }
         g.colours = vec![[0.5; 3]; g.points.len()];
         g.normals = vec![V3::z(); g.points.len()];

@@ -206,7 +206,11 @@ mod tests {
         let t = KdTree::new(&pts);
         let mut out = Vec::new();
         for _ in 0..200 {
-            let q = P3::new(rng.range(-0.2, 1.2), rng.range(-0.2, 2.2), rng.range(-0.2, 0.7));
+            let q = P3::new(
+                rng.range(-0.2, 1.2),
+                rng.range(-0.2, 2.2),
+                rng.range(-0.2, 0.7),
+            );
             let (i, d) = t.nearest(&q).unwrap();
             let bf = pts
                 .iter()

@@ -184,22 +184,50 @@ pub fn silhouette_area(mesh: &VisualMesh, window: ([f64; 2], [f64; 2]), cells: u
         for t in &part.triangles {
             let q = t.map(|i| {
                 let p = part.positions[i as usize];
-                [(p.x - lo[0]) / w[0] * cells as f64, (p.y - lo[1]) / w[1] * cells as f64]
+                [
+                    (p.x - lo[0]) / w[0] * cells as f64,
+                    (p.y - lo[1]) / w[1] * cells as f64,
+                ]
             });
-            let area2 = (q[1][0] - q[0][0]) * (q[2][1] - q[0][1]) - (q[2][0] - q[0][0]) * (q[1][1] - q[0][1]);
+            let area2 = (q[1][0] - q[0][0]) * (q[2][1] - q[0][1])
+                - (q[2][0] - q[0][0]) * (q[1][1] - q[0][1]);
             if area2 == 0.0 {
                 continue;
             }
-            let x0 = q.iter().map(|p| p[0]).fold(f64::INFINITY, f64::min).floor().max(0.0) as usize;
-            let x1 = (q.iter().map(|p| p[0]).fold(f64::NEG_INFINITY, f64::max).ceil() as usize).min(cells);
-            let y0 = q.iter().map(|p| p[1]).fold(f64::INFINITY, f64::min).floor().max(0.0) as usize;
-            let y1 = (q.iter().map(|p| p[1]).fold(f64::NEG_INFINITY, f64::max).ceil() as usize).min(cells);
+            let x0 = q
+                .iter()
+                .map(|p| p[0])
+                .fold(f64::INFINITY, f64::min)
+                .floor()
+                .max(0.0) as usize;
+            let x1 = (q
+                .iter()
+                .map(|p| p[0])
+                .fold(f64::NEG_INFINITY, f64::max)
+                .ceil() as usize)
+                .min(cells);
+            let y0 = q
+                .iter()
+                .map(|p| p[1])
+                .fold(f64::INFINITY, f64::min)
+                .floor()
+                .max(0.0) as usize;
+            let y1 = (q
+                .iter()
+                .map(|p| p[1])
+                .fold(f64::NEG_INFINITY, f64::max)
+                .ceil() as usize)
+                .min(cells);
             for y in y0..y1 {
                 for x in x0..x1 {
                     let c = [x as f64 + 0.5, y as f64 + 0.5];
-                    let e = |a: [f64; 2], b: [f64; 2]| (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]);
+                    let e = |a: [f64; 2], b: [f64; 2]| {
+                        (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0])
+                    };
                     let (e0, e1, e2) = (e(q[0], q[1]), e(q[1], q[2]), e(q[2], q[0]));
-                    if (e0 >= 0.0 && e1 >= 0.0 && e2 >= 0.0) || (e0 <= 0.0 && e1 <= 0.0 && e2 <= 0.0) {
+                    if (e0 >= 0.0 && e1 >= 0.0 && e2 >= 0.0)
+                        || (e0 <= 0.0 && e1 <= 0.0 && e2 <= 0.0)
+                    {
                         covered[y * cells + x] = true;
                     }
                 }
@@ -300,12 +328,19 @@ fn register(
     };
     let g_icp = guidance.subsample(1500);
     let (t, rms) = trimmed_icp(&object.points, &matcher, &g_icp, init, &icp);
-    let probe_g: Vec<usize> = (0..guidance.len()).step_by((guidance.len() / 700).max(1)).collect();
-    let probe_o: Vec<usize> = (0..object.len()).step_by((object.len() / 700).max(1)).collect();
+    let probe_g: Vec<usize> = (0..guidance.len())
+        .step_by((guidance.len() / 700).max(1))
+        .collect();
+    let probe_o: Vec<usize> = (0..object.len())
+        .step_by((object.len() / 700).max(1))
+        .collect();
     let score = global::score(&p, &t, use_colour, &probe_g, &probe_o);
     (
         t,
-        format!("{stages}+trimmed_icp{}", if use_colour { "+colour" } else { "" }),
+        format!(
+            "{stages}+trimmed_icp{}",
+            if use_colour { "+colour" } else { "" }
+        ),
         scale0,
         score,
         rms,
@@ -321,7 +356,10 @@ pub fn compose(inputs: &[ObjectInput], o: &ComposeOptions) -> Result<Composition
     }
     for i in inputs {
         if i.visual.triangle_count() == 0 || i.guidance.triangle_count() == 0 {
-            return Err(Error::Usage(format!("object {:?}: mesh or guidance part has no triangles", i.name)));
+            return Err(Error::Usage(format!(
+                "object {:?}: mesh or guidance part has no triangles",
+                i.name
+            )));
         }
     }
     // Silhouettes on a common window.
@@ -468,8 +506,16 @@ pub fn fix_penetration(scene: &mut crate::scene::Scene, o: &RefineOptions) -> Ve
             let report = FixReport {
                 name: ob.name.clone(),
                 penetration_before: r.penetration_before,
-                penetration_after: if r.penetration_before > 0.0 { r.penetration_after } else { 0.0 },
-                moved: if r.penetration_before > 0.0 { r.moved } else { 0.0 },
+                penetration_after: if r.penetration_before > 0.0 {
+                    r.penetration_after
+                } else {
+                    0.0
+                },
+                moved: if r.penetration_before > 0.0 {
+                    r.moved
+                } else {
+                    0.0
+                },
             };
             if r.penetration_before > 0.0 {
                 scene.objects[i].pose = r.transform;

@@ -43,7 +43,8 @@ impl Obb {
         if !points.is_empty() {
             for k in 0..3 {
                 let ax = axes.column(k).into_owned();
-                let mut proj: Vec<f64> = points.iter().map(|p| ax.dot(&(p.coords - mean))).collect();
+                let mut proj: Vec<f64> =
+                    points.iter().map(|p| ax.dot(&(p.coords - mean))).collect();
                 proj.sort_by(f64::total_cmp);
                 let cut = proj.len() / 200;
                 lo[k] = proj[cut];
@@ -88,7 +89,14 @@ pub fn scale_ratio(object: &Obb, guidance: &Obb) -> f64 {
 
 /// The 24 proper rotations that permute and flip the three axes (the symmetries of a box).
 pub fn axis_permutations() -> Vec<Matrix3<f64>> {
-    let perms = [[0, 1, 2], [0, 2, 1], [1, 0, 2], [1, 2, 0], [2, 0, 1], [2, 1, 0]];
+    let perms = [
+        [0, 1, 2],
+        [0, 2, 1],
+        [1, 0, 2],
+        [1, 2, 0],
+        [2, 0, 1],
+        [2, 1, 0],
+    ];
     let mut out = Vec::with_capacity(24);
     for p in perms {
         for signs in 0..8u32 {

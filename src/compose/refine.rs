@@ -158,7 +158,9 @@ pub fn refine(
         for _ in 0..steps {
             let m = t.matrix();
             let placed: Vec<P3> = points.iter().map(|p| m.transform_point(p)).collect();
-            let c = P3::from(placed.iter().fold(V3::zeros(), |a, p| a + p.coords) / placed.len().max(1) as f64);
+            let c = P3::from(
+                placed.iter().fold(V3::zeros(), |a, p| a + p.coords) / placed.len().max(1) as f64,
+            );
             let energy = |tt: &Similarity| -> f64 {
                 let mm = tt.matrix();
                 let mut e = 0.0;
@@ -180,7 +182,8 @@ pub fn refine(
                 let mut j = nalgebra::Matrix3x6::zeros();
                 j.fixed_view_mut::<3, 3>(0, 0)
                     .copy_from(&(-skew(&(x - c)) / unit));
-                j.fixed_view_mut::<3, 3>(0, 3).copy_from(&Matrix3::identity());
+                j.fixed_view_mut::<3, 3>(0, 3)
+                    .copy_from(&Matrix3::identity());
                 j
             };
             for (oi, gp) in &pairs {
@@ -272,7 +275,10 @@ mod tests {
         let o = RefineOptions::default();
         let out = refine(&pts, &Target::InitialPose, init, &field, 0.2, &o);
         assert!(out.penetration_before > 0.009, "{out:?}");
-        assert!(out.penetration_after <= o.tolerance * 0.2 + 1e-12, "{out:?}");
+        assert!(
+            out.penetration_after <= o.tolerance * 0.2 + 1e-12,
+            "{out:?}"
+        );
         // The minimal correction is a 10 mm push along +x (plus the ε clearance, 0.4 mm);
         // it should neither rotate noticeably nor move sideways.
         let c = out.transform.translation;

@@ -80,7 +80,11 @@ pub fn load_truth(dir: &Path) -> Result<Vec<TruthObject>> {
 }
 
 fn hash3(p: &P3, seed: u64) -> u64 {
-    let mut r = Rng::new(seed ^ p.x.to_bits().rotate_left(7) ^ p.y.to_bits().rotate_left(19) ^ p.z.to_bits().rotate_left(37));
+    let mut r = Rng::new(
+        seed ^ p.x.to_bits().rotate_left(7)
+            ^ p.y.to_bits().rotate_left(19)
+            ^ p.z.to_bits().rotate_left(37),
+    );
     r.next_u64()
 }
 
@@ -127,7 +131,11 @@ fn cluster(part: &mut VisualPart, cell: f64) {
     let remap: Vec<u32> = (0..part.positions.len())
         .map(|i| {
             let p = part.positions[i];
-            let key = [(p.x / cell).floor() as i64, (p.y / cell).floor() as i64, (p.z / cell).floor() as i64];
+            let key = [
+                (p.x / cell).floor() as i64,
+                (p.y / cell).floor() as i64,
+                (p.z / cell).floor() as i64,
+            ];
             *map.entry(key).or_insert_with(|| {
                 pos.push(p);
                 if let (Some(u), Some(src)) = (&mut uvs, &part.uvs) {
@@ -172,7 +180,8 @@ pub fn make(objects: &[TruthObject], seed: u64, o: &SynthOptions) -> Synthetic {
         .reduce(|a, b| a.union(&b))
         .expect("scene has geometry");
     let diag = scene_bb.diagonal();
-    let yaw = UnitQuaternion::from_axis_angle(&Vector3::y_axis(), rng.range(0.0, std::f64::consts::TAU));
+    let yaw =
+        UnitQuaternion::from_axis_angle(&Vector3::y_axis(), rng.range(0.0, std::f64::consts::TAU));
     let tilt_axis = Vector3::new(rng.range(-1.0, 1.0), 0.0, rng.range(-1.0, 1.0));
     let tilt = if tilt_axis.norm() > 1e-9 {
         UnitQuaternion::from_axis_angle(
@@ -185,7 +194,11 @@ pub fn make(objects: &[TruthObject], seed: u64, o: &SynthOptions) -> Synthetic {
     let frame = Similarity {
         scale: (rng.range(o.scale[0].ln(), o.scale[1].ln())).exp(),
         rotation: tilt * yaw,
-        translation: V3::new(rng.range(-1.0, 1.0), rng.range(-1.0, 1.0), rng.range(-1.0, 1.0)) * diag,
+        translation: V3::new(
+            rng.range(-1.0, 1.0),
+            rng.range(-1.0, 1.0),
+            rng.range(-1.0, 1.0),
+        ) * diag,
     };
     let truth: Vec<Similarity> = objects.iter().map(|t| frame.then_after(&t.pose)).collect();
     let placed: Vec<VisualMesh> = objects
@@ -229,7 +242,11 @@ pub fn make(objects: &[TruthObject], seed: u64, o: &SynthOptions) -> Synthetic {
         }
         let mut centres: Vec<P3> = Vec::new();
         let random_point = |rng: &mut Rng| clouds[i].points[rng.below(clouds[i].len())];
-        centres.push(contact.map(|c| c.1).unwrap_or_else(|| random_point(&mut rng)));
+        centres.push(
+            contact
+                .map(|c| c.1)
+                .unwrap_or_else(|| random_point(&mut rng)),
+        );
         centres.push(random_point(&mut rng));
         // Ragged holes: remove triangles by (noisy) distance to the nearest centre.
         let frac = rng.range(o.hole_fraction[0], o.hole_fraction[1]);
@@ -252,7 +269,10 @@ pub fn make(objects: &[TruthObject], seed: u64, o: &SynthOptions) -> Synthetic {
             }
         }
         tri_list.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)).then(a.2.cmp(&b.2)));
-        let mut keep: Vec<Vec<bool>> = parts.iter().map(|p| vec![true; p.triangles.len()]).collect();
+        let mut keep: Vec<Vec<bool>> = parts
+            .iter()
+            .map(|p| vec![true; p.triangles.len()])
+            .collect();
         let mut gone = 0.0;
         for &(_, pi, ti, a) in &tri_list {
             if gone >= frac * total {
@@ -262,7 +282,11 @@ pub fn make(objects: &[TruthObject], seed: u64, o: &SynthOptions) -> Synthetic {
             gone += a;
         }
         removed.push(gone / total.max(1e-300));
-        let mut out: Vec<VisualPart> = parts.iter().zip(&keep).map(|(p, k)| keep_triangles(p, k)).collect();
+        let mut out: Vec<VisualPart> = parts
+            .iter()
+            .zip(&keep)
+            .map(|(p, k)| keep_triangles(p, k))
+            .collect();
         // Fused segmentation: neighbour triangles near this object and near the contact.
         if let Some((_, cpt)) = contact {
             let mut budget = 0.08 * total;
@@ -301,8 +325,9 @@ pub fn make(objects: &[TruthObject], seed: u64, o: &SynthOptions) -> Synthetic {
             }
             cluster(p, o.cluster * d_i);
             for k in 0..3 {
-                p.material.base_color[k] =
-                    (p.material.base_color[k] * (1.0 + rng.range(-o.colour_gain, o.colour_gain))).clamp(0.0, 1.0);
+                p.material.base_color[k] = (p.material.base_color[k]
+                    * (1.0 + rng.range(-o.colour_gain, o.colour_gain)))
+                .clamp(0.0, 1.0);
             }
         }
         out.retain(|p| !p.triangles.is_empty());
@@ -328,7 +353,8 @@ pub fn write_sample(s: &Synthetic, source: Option<&Path>, dir: &Path) -> Result<
         let f = format!("{}.glb", inp.name);
         match source {
             Some(src) if src.join(&f).is_file() => {
-                std::fs::copy(src.join(&f), dir.join(&f)).map_err(|e| crate::Error::io(src.join(&f), e))?;
+                std::fs::copy(src.join(&f), dir.join(&f))
+                    .map_err(|e| crate::Error::io(src.join(&f), e))?;
             }
             _ => crate::io::write_glb(&inp.visual, &dir.join(&f))?,
         }
@@ -341,7 +367,12 @@ pub fn write_sample(s: &Synthetic, source: Option<&Path>, dir: &Path) -> Result<
         .zip(&s.truth)
         .map(|(i, t)| {
             let m = t.matrix();
-            (i.name.clone(), (0..4).map(|a| (0..4).map(|b| m[(a, b)]).collect()).collect())
+            (
+                i.name.clone(),
+                (0..4)
+                    .map(|a| (0..4).map(|b| m[(a, b)]).collect())
+                    .collect(),
+            )
         })
         .collect();
     crate::fsutil::write(
@@ -355,10 +386,16 @@ pub fn write_sample(s: &Synthetic, source: Option<&Path>, dir: &Path) -> Result<
     if let Some(src) = source {
         if src.join("metadata.json").is_file() {
             // Copy the descriptive fields, not the registration (that is what compose finds).
-            let text = std::fs::read_to_string(src.join("metadata.json")).map_err(|e| crate::Error::io(src, e))?;
-            if let Ok(serde_json::Value::Object(mut m)) = serde_json::from_str::<serde_json::Value>(&text) {
+            let text = std::fs::read_to_string(src.join("metadata.json"))
+                .map_err(|e| crate::Error::io(src, e))?;
+            if let Ok(serde_json::Value::Object(mut m)) =
+                serde_json::from_str::<serde_json::Value>(&text)
+            {
                 m.remove("registration");
-                crate::fsutil::write(&dir.join("metadata.json"), &crate::fsutil::json_bytes(&serde_json::Value::Object(m))?)?;
+                crate::fsutil::write(
+                    &dir.join("metadata.json"),
+                    &crate::fsutil::json_bytes(&serde_json::Value::Object(m))?,
+                )?;
             }
         }
     }
@@ -393,7 +430,9 @@ pub fn appearance_equivalent(visual: &VisualMesh, est: &Similarity, truth: &Simi
         .filter(|(p, col)| {
             tree.within(p, tol, &mut near);
             near.iter().any(|&j| {
-                let dc: f64 = (0..3).map(|k| (col[k] - b.colours[j][k]).powi(2)).sum::<f64>();
+                let dc: f64 = (0..3)
+                    .map(|k| (col[k] - b.colours[j][k]).powi(2))
+                    .sum::<f64>();
                 dc.sqrt() < 0.2
             })
         })
@@ -415,20 +454,34 @@ pub fn asymmetric_texture(hue: u8, origin: &str) -> crate::mesh::Texture {
     crate::shapes::png_texture(&img, origin)
 }
 
-fn unit_visual(mesh: &crate::mesh::Mesh, proj: crate::shapes::UvProjection, hue: u8, z_to_y: bool) -> (VisualMesh, f64) {
+fn unit_visual(
+    mesh: &crate::mesh::Mesh,
+    proj: crate::shapes::UvProjection,
+    hue: u8,
+    z_to_y: bool,
+) -> (VisualMesh, f64) {
     let mut v = crate::shapes::visual(
         mesh,
         proj,
-        crate::shapes::textured_material(&format!("print{hue}"), asymmetric_texture(hue, "generated")),
+        crate::shapes::textured_material(
+            &format!("print{hue}"),
+            asymmetric_texture(hue, "generated"),
+        ),
     );
     if z_to_y {
-        v.transform(&UnitQuaternion::from_axis_angle(&Vector3::x_axis(), -std::f64::consts::FRAC_PI_2).to_homogeneous());
+        v.transform(
+            &UnitQuaternion::from_axis_angle(&Vector3::x_axis(), -std::f64::consts::FRAC_PI_2)
+                .to_homogeneous(),
+        );
     }
     // Normalise like a generator: centred, longest extent 1.
     let bb = v.geometry().aabb().unwrap();
     let s = bb.extents().max();
     let c = bb.center();
-    v.transform(&(nalgebra::Matrix4::new_scaling(1.0 / s) * nalgebra::Translation3::from(-c.coords).to_homogeneous()));
+    v.transform(
+        &(nalgebra::Matrix4::new_scaling(1.0 / s)
+            * nalgebra::Translation3::from(-c.coords).to_homogeneous()),
+    );
     (v, s)
 }
 
@@ -438,7 +491,12 @@ pub fn symmetric_scenes() -> Vec<(String, Vec<TruthObject>)> {
     use crate::shapes::{cuboid, cylinder, UvProjection};
     let yaw = |deg: f64| UnitQuaternion::from_axis_angle(&Vector3::y_axis(), deg.to_radians());
     let support = |ext: V3, hue: u8| -> TruthObject {
-        let (v, s) = unit_visual(&cuboid(ext), UvProjection::Box { tile: ext.max() }, hue, false);
+        let (v, s) = unit_visual(
+            &cuboid(ext),
+            UvProjection::Box { tile: ext.max() },
+            hue,
+            false,
+        );
         TruthObject {
             name: "object_a".into(),
             visual: v,
@@ -449,7 +507,14 @@ pub fn symmetric_scenes() -> Vec<(String, Vec<TruthObject>)> {
             },
         }
     };
-    let on_top = |mesh: crate::mesh::Mesh, proj, hue, z_to_y, half_height: f64, top: f64, deg: f64, dx: f64| {
+    let on_top = |mesh: crate::mesh::Mesh,
+                  proj,
+                  hue,
+                  z_to_y,
+                  half_height: f64,
+                  top: f64,
+                  deg: f64,
+                  dx: f64| {
         let (v, s) = unit_visual(&mesh, proj, hue, z_to_y);
         TruthObject {
             name: "object_b".into(),
@@ -466,21 +531,48 @@ pub fn symmetric_scenes() -> Vec<(String, Vec<TruthObject>)> {
             "sym_box_board".into(),
             vec![
                 support(V3::new(0.40, 0.024, 0.30), 40),
-                on_top(cuboid(V3::new(0.12, 0.06, 0.08)), UvProjection::Box { tile: 0.12 }, 200, false, 0.03, 0.024, 30.0, 0.02),
+                on_top(
+                    cuboid(V3::new(0.12, 0.06, 0.08)),
+                    UvProjection::Box { tile: 0.12 },
+                    200,
+                    false,
+                    0.03,
+                    0.024,
+                    30.0,
+                    0.02,
+                ),
             ],
         ),
         (
             "sym_book_box".into(),
             vec![
                 support(V3::new(0.30, 0.10, 0.25), 90),
-                on_top(cuboid(V3::new(0.21, 0.03, 0.15)), UvProjection::Box { tile: 0.21 }, 250, false, 0.015, 0.10, 15.0, 0.0),
+                on_top(
+                    cuboid(V3::new(0.21, 0.03, 0.15)),
+                    UvProjection::Box { tile: 0.21 },
+                    250,
+                    false,
+                    0.015,
+                    0.10,
+                    15.0,
+                    0.0,
+                ),
             ],
         ),
         (
             "sym_can_board".into(),
             vec![
                 support(V3::new(0.30, 0.024, 0.24), 140),
-                on_top(cylinder(0.033, 0.10, 48), UvProjection::Cylindrical { repeat: 1.0 }, 10, true, 0.05, 0.024, 70.0, 0.03),
+                on_top(
+                    cylinder(0.033, 0.10, 48),
+                    UvProjection::Cylindrical { repeat: 1.0 },
+                    10,
+                    true,
+                    0.05,
+                    0.024,
+                    70.0,
+                    0.03,
+                ),
             ],
         ),
     ]
