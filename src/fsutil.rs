@@ -37,15 +37,18 @@ pub fn json_bytes<T: serde::Serialize>(v: &T) -> Result<Vec<u8>> {
 }
 
 /// Whether `out` may be replaced: missing, empty, or an earlier interact3d export (has a
-/// `report.json` written by us).
+/// `report.json` written by us) or `compose` output (its `metadata.json` names the tool).
 fn replaceable(out: &Path) -> bool {
     match std::fs::read_dir(out) {
         Err(_) => true,
         Ok(mut it) => {
             it.next().is_none()
-                || std::fs::read_to_string(out.join("report.json"))
-                    .map(|s| s.contains("\"tool\": \"interact3d\""))
-                    .unwrap_or(false)
+                || ["report.json", "metadata.json"].iter().any(|f| {
+                    // report.json: an export; metadata.json: a `compose` output.
+                    std::fs::read_to_string(out.join(f))
+                        .map(|s| s.contains("\"tool\": \"interact3d\""))
+                        .unwrap_or(false)
+                })
         }
     }
 }

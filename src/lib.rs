@@ -8,6 +8,7 @@
 
 pub mod batch;
 pub mod body;
+pub mod compose;
 pub mod decompose;
 pub mod error;
 pub mod export;

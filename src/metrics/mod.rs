@@ -176,6 +176,22 @@ impl Prepared {
         self.contains_v(v(p))
     }
 
+    /// Signed distance from `p` to the surface (negative inside, by the same inside test as
+    /// [`Prepared::contains`]) and the nearest surface point. Used by the collision-aware
+    /// refinement of `compose` near the anchor's surface, where a grid would blur thin walls.
+    pub fn signed_distance(&self, p: &P3) -> (f64, P3) {
+        let q = v(p);
+        let (d2, t) = self.surface.nearest(q, None);
+        if t == usize::MAX {
+            return (f64::INFINITY, *p);
+        }
+        let tri = &self.surface.tris[t];
+        let c = geom::closest_on_tri(q, tri[0], tri[1], tri[2]);
+        let d = d2.sqrt();
+        let s = if self.contains_v(q) { -d } else { d };
+        (s, P3::new(c[0], c[1], c[2]))
+    }
+
     fn contains_v(&self, p: V) -> bool {
         if !self.bb.contains(p) {
             return false;

@@ -1,0 +1,531 @@
+//! `compose`: the Interact3D registration pipeline on a CPU, without learned weights.
+//!
+//! Each high-quality object mesh (its own frame) is registered onto its guidance part, a
+//! segment of a generated scene mesh with holes and artefacts (guidance frame):
+//!
+//! 1. anchor: the object whose guidance part has the larger silhouette (front view, along −Z of
+//!    the Y-up guidance frame), unless named;
+//! 2. scale initialised from the ratio of sorted OBB extents ([`obb`]);
+//! 3. global registration ([`global`]): hypotheses from the 24 OBB axis permutations and from
+//!    FPFH + RANSAC ([`features`]), each refined by a short trimmed ICP and scored (colour-
+//!    weighted when both meshes carry colour, [`colour`]);
+//! 4. scale-aware trimmed ICP with Umeyama and a bounded scale ([`icp`]);
+//! 5. collision-aware refinement of every further object against the fixed, already composed
+//!    objects' signed distance field ([`sdf`], [`refine`]); objects are added one at a time, the
+//!    composed scene becoming the new anchor.
+//!
+//! Everything is deterministic for a seed. [`synth`] makes guidance parts from ground-truth
+//! scenes for tests and the benchmark; [`folder`] reads sample folders and writes the output.
+
+pub mod cloud;
+pub mod colour;
+pub mod features;
+pub mod folder;
+pub mod global;
+pub mod icp;
+pub mod kdtree;
+pub mod obb;
+pub mod refine;
+pub mod rng;
+pub mod sdf;
+pub mod synth;
+
+use crate::error::{Error, Result};
+use crate::mesh::{Mesh, VisualMesh};
+use crate::pose::Similarity;
+use cloud::Cloud;
+use global::{best_hypothesis, FpfhRansac, GlobalRegistration, ObbHypotheses, Problem};
+use icp::{trimmed_icp, IcpOptions};
+
+/// Weight of a unit of (gain-normalised) colour difference in colour-aware correspondences, as a
+/// fraction of the object's diagonal.
+pub const COLOUR_WEIGHT: f64 = 0.1;
+use kdtree::KdTree;
+use obb::Obb;
+use refine::{refine, RefineOptions, Refined, Target};
+use sdf::AnchorField;
+use serde::Serialize;
+
+/// Which stages run (the rows of the ablation table).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, clap::ValueEnum)]
+#[serde(rename_all = "snake_case")]
+pub enum Method {
+    /// OBB alignment (one hypothesis, no permutations) + ICP.
+    IcpOnly,
+    /// FPFH + RANSAC (its best pose) + ICP.
+    RansacIcp,
+    /// All hypotheses (OBB permutations + RANSAC), scored, + ICP.
+    GlobalIcp,
+    /// Global + ICP + collision-aware refinement.
+    Full,
+    /// Full, with colour in the hypothesis score when both meshes carry colour.
+    FullColour,
+}
+
+impl Method {
+    pub const ALL: [Method; 5] = [
+        Method::IcpOnly,
+        Method::RansacIcp,
+        Method::GlobalIcp,
+        Method::Full,
+        Method::FullColour,
+    ];
+    pub fn label(&self) -> &'static str {
+        match self {
+            Method::IcpOnly => "ICP only",
+            Method::RansacIcp => "RANSAC+ICP",
+            Method::GlobalIcp => "global+ICP",
+            Method::Full => "full",
+            Method::FullColour => "full + colour",
+        }
+    }
+    fn refines(&self) -> bool {
+        matches!(self, Method::Full | Method::FullColour)
+    }
+}
+
+/// Options of the pipeline.
+#[derive(Clone, Debug)]
+pub struct ComposeOptions {
+    pub method: Method,
+    pub seed: u64,
+    /// Anchor object by name (default: the larger guidance silhouette).
+    pub anchor: Option<String>,
+    /// Surface samples of each object and each guidance part.
+    pub object_samples: usize,
+    pub guidance_samples: usize,
+    pub refine: RefineOptions,
+}
+
+impl Default for ComposeOptions {
+    fn default() -> Self {
+        ComposeOptions {
+            method: Method::FullColour,
+            seed: 0,
+            anchor: None,
+            object_samples: 5000,
+            guidance_samples: 2500,
+            refine: RefineOptions::default(),
+        }
+    }
+}
+
+/// One object to compose: its mesh (own frame) and its guidance part (guidance frame).
+#[derive(Clone, Debug)]
+pub struct ObjectInput {
+    pub name: String,
+    pub visual: VisualMesh,
+    pub guidance: VisualMesh,
+}
+
+/// The registration of one object.
+#[derive(Clone, Debug, Serialize)]
+pub struct ObjectResult {
+    pub name: String,
+    #[serde(skip)]
+    pub transform: Similarity,
+    /// Stages that produced the transform, e.g. `obb+fpfh_ransac+trimmed_icp+collision_refine`.
+    pub method: String,
+    /// Silhouette area of the guidance part (guidance units²).
+    pub silhouette_area: f64,
+    pub initial_scale: f64,
+    /// Hypothesis score of the chosen pose (fraction of guidance explained + ½ object covered).
+    pub score: f64,
+    /// RMS of the kept ICP correspondences (guidance units).
+    pub icp_rms: f64,
+    pub hypotheses: usize,
+    pub colour_used: bool,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub refinement: Option<RefineReport>,
+}
+
+#[derive(Clone, Copy, Debug, Serialize)]
+pub struct RefineReport {
+    pub penetration_before: f64,
+    pub penetration_after: f64,
+    pub moved: f64,
+    pub beta_doublings: usize,
+}
+
+impl From<&Refined> for RefineReport {
+    fn from(r: &Refined) -> Self {
+        RefineReport {
+            penetration_before: r.penetration_before,
+            penetration_after: r.penetration_after,
+            moved: r.moved,
+            beta_doublings: r.continuation,
+        }
+    }
+}
+
+/// The composed scene.
+#[derive(Clone, Debug, Serialize)]
+pub struct Composition {
+    pub anchor: String,
+    /// Objects in the order they were composed (anchor first).
+    pub objects: Vec<ObjectResult>,
+    /// Diagonal of all guidance parts together (the length unit of the refinement).
+    pub scene_diagonal: f64,
+}
+
+impl Composition {
+    pub fn get(&self, name: &str) -> Option<&ObjectResult> {
+        self.objects.iter().find(|o| o.name == name)
+    }
+}
+
+/// Silhouette area of a mesh seen along −Z (front view of the Y-up guidance frame), on a
+/// `cells`² raster over `window` (x, y bounds).
+pub fn silhouette_area(mesh: &VisualMesh, window: ([f64; 2], [f64; 2]), cells: usize) -> f64 {
+    let (lo, hi) = window;
+    let w = [(hi[0] - lo[0]).max(1e-12), (hi[1] - lo[1]).max(1e-12)];
+    let mut covered = vec![false; cells * cells];
+    for part in &mesh.parts {
+        for t in &part.triangles {
+            let q = t.map(|i| {
+                let p = part.positions[i as usize];
+                [
+                    (p.x - lo[0]) / w[0] * cells as f64,
+                    (p.y - lo[1]) / w[1] * cells as f64,
+                ]
+            });
+            let area2 = (q[1][0] - q[0][0]) * (q[2][1] - q[0][1])
+                - (q[2][0] - q[0][0]) * (q[1][1] - q[0][1]);
+            if area2 == 0.0 {
+                continue;
+            }
+            let x0 = q
+                .iter()
+                .map(|p| p[0])
+                .fold(f64::INFINITY, f64::min)
+                .floor()
+                .max(0.0) as usize;
+            let x1 = (q
+                .iter()
+                .map(|p| p[0])
+                .fold(f64::NEG_INFINITY, f64::max)
+                .ceil() as usize)
+                .min(cells);
+            let y0 = q
+                .iter()
+                .map(|p| p[1])
+                .fold(f64::INFINITY, f64::min)
+                .floor()
+                .max(0.0) as usize;
+            let y1 = (q
+                .iter()
+                .map(|p| p[1])
+                .fold(f64::NEG_INFINITY, f64::max)
+                .ceil() as usize)
+                .min(cells);
+            for y in y0..y1 {
+                for x in x0..x1 {
+                    let c = [x as f64 + 0.5, y as f64 + 0.5];
+                    let e = |a: [f64; 2], b: [f64; 2]| {
+                        (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0])
+                    };
+                    let (e0, e1, e2) = (e(q[0], q[1]), e(q[1], q[2]), e(q[2], q[0]));
+                    if (e0 >= 0.0 && e1 >= 0.0 && e2 >= 0.0)
+                        || (e0 <= 0.0 && e1 <= 0.0 && e2 <= 0.0)
+                    {
+                        covered[y * cells + x] = true;
+                    }
+                }
+            }
+        }
+    }
+    covered.iter().filter(|&&c| c).count() as f64 * w[0] * w[1] / (cells * cells) as f64
+}
+
+fn name_seed(seed: u64, name: &str) -> u64 {
+    // FNV-1a of the name, mixed with the seed: stable across runs and platforms.
+    let mut h: u64 = 0xcbf2_9ce4_8422_2325;
+    for b in name.bytes() {
+        h ^= b as u64;
+        h = h.wrapping_mul(0x100_0000_01b3);
+    }
+    h ^ seed.wrapping_mul(0x9E37_79B9_7F4A_7C15)
+}
+
+/// Register one object onto its guidance part (steps 2–4).
+fn register(
+    object: &Cloud,
+    guidance: &Cloud,
+    method: Method,
+    seed: u64,
+) -> (Similarity, String, f64, f64, f64, usize, bool) {
+    let object_tree = KdTree::new(&object.points);
+    let guidance_tree = KdTree::new(&guidance.points);
+    let object_obb = Obb::of_points(&object.points);
+    let guidance_obb = Obb::of_points(&guidance.points);
+    let scale0 = obb::scale_ratio(&object_obb, &guidance_obb);
+    let p = Problem {
+        object,
+        object_tree: &object_tree,
+        guidance,
+        guidance_tree: &guidance_tree,
+        object_obb,
+        guidance_obb,
+        scale0,
+        seed,
+    };
+    let icp = IcpOptions {
+        iterations: 60,
+        keep: 0.8,
+        scale_lo: scale0 / 1.4,
+        scale_hi: scale0 * 1.4,
+        tolerance: 1e-5 * p.guidance_diagonal(),
+    };
+    let use_colour = method == Method::FullColour && colour::usable(object, guidance);
+    let (hyps, stages): (Vec<Similarity>, &str) = match method {
+        Method::IcpOnly => (
+            ObbHypotheses {
+                all_permutations: false,
+            }
+            .hypotheses(&p),
+            "obb",
+        ),
+        Method::RansacIcp => {
+            let mut h = FpfhRansac {
+                keep: 1,
+                ..Default::default()
+            }
+            .hypotheses(&p);
+            if h.is_empty() {
+                h = ObbHypotheses {
+                    all_permutations: false,
+                }
+                .hypotheses(&p);
+            }
+            (h, "fpfh_ransac")
+        }
+        _ => {
+            let mut h = ObbHypotheses {
+                all_permutations: true,
+            }
+            .hypotheses(&p);
+            h.extend(FpfhRansac::default().hypotheses(&p));
+            (h, "obb_permutations+fpfh_ransac")
+        }
+    };
+    let n_hyp = hyps.len();
+    let colour_tree;
+    let matcher = if use_colour {
+        colour_tree = icp::Matcher::colour_tree(object, COLOUR_WEIGHT * object.diagonal());
+        icp::Matcher::Colour {
+            tree: &colour_tree,
+            weight: COLOUR_WEIGHT * object.diagonal(),
+        }
+    } else {
+        icp::Matcher::Geometry(&object_tree)
+    };
+    let init = if hyps.len() == 1 {
+        hyps[0]
+    } else {
+        best_hypothesis(&p, &hyps, &matcher, use_colour, &icp)
+            .map(|(t, _)| t)
+            .unwrap_or(hyps[0])
+    };
+    let g_icp = guidance.subsample(1500);
+    let (t, rms) = trimmed_icp(&object.points, &matcher, &g_icp, init, &icp);
+    let probe_g: Vec<usize> = (0..guidance.len())
+        .step_by((guidance.len() / 700).max(1))
+        .collect();
+    let probe_o: Vec<usize> = (0..object.len())
+        .step_by((object.len() / 700).max(1))
+        .collect();
+    let score = global::score(&p, &t, use_colour, &probe_g, &probe_o);
+    (
+        t,
+        format!(
+            "{stages}+trimmed_icp{}",
+            if use_colour { "+colour" } else { "" }
+        ),
+        scale0,
+        score,
+        rms,
+        n_hyp,
+        use_colour,
+    )
+}
+
+/// Compose the objects (steps 1–5). Errors only on unusable input (an empty mesh).
+pub fn compose(inputs: &[ObjectInput], o: &ComposeOptions) -> Result<Composition> {
+    if inputs.is_empty() {
+        return Err(Error::Usage("compose needs at least one object".into()));
+    }
+    for i in inputs {
+        if i.visual.triangle_count() == 0 || i.guidance.triangle_count() == 0 {
+            return Err(Error::Usage(format!(
+                "object {:?}: mesh or guidance part has no triangles",
+                i.name
+            )));
+        }
+    }
+    // Silhouettes on a common window.
+    let mut bb: Option<crate::mesh::Aabb> = None;
+    for i in inputs {
+        if let Some(b) = i.guidance.geometry().aabb() {
+            bb = Some(bb.map_or(b, |a| a.union(&b)));
+        }
+    }
+    let bb = bb.ok_or_else(|| Error::Usage("guidance meshes are empty".into()))?;
+    let window = ([bb.min.x, bb.min.y], [bb.max.x, bb.max.y]);
+    let areas: Vec<f64> = inputs
+        .iter()
+        .map(|i| silhouette_area(&i.guidance, window, 256))
+        .collect();
+    let mut order: Vec<usize> = (0..inputs.len()).collect();
+    order.sort_by(|&a, &b| areas[b].total_cmp(&areas[a]).then(a.cmp(&b)));
+    if let Some(name) = &o.anchor {
+        let k = inputs
+            .iter()
+            .position(|i| &i.name == name)
+            .ok_or_else(|| Error::Usage(format!("--anchor {name}: no such object")))?;
+        order.retain(|&i| i != k);
+        order.insert(0, k);
+    }
+    let unit = bb.diagonal();
+    let mut field: Option<AnchorField> = None;
+    let mut results = Vec::new();
+    for (rank, &i) in order.iter().enumerate() {
+        let inp = &inputs[i];
+        let seed = name_seed(o.seed, &inp.name);
+        let mut object = Cloud::sample(&inp.visual, o.object_samples, seed);
+        let mut guidance = Cloud::sample(&inp.guidance, o.guidance_samples, seed ^ 1);
+        colour::normalise(&mut object);
+        colour::normalise(&mut guidance);
+        let (mut t, mut method, scale0, score, rms, n_hyp, colour_used) =
+            register(&object, &guidance, o.method, seed);
+        let mut refinement = None;
+        if rank > 0 && o.method.refines() {
+            if let Some(f) = &field {
+                let g = guidance.subsample(600);
+                let sub = object.subsample(700);
+                let sub_tree = KdTree::new(&sub.points);
+                let colour_sub;
+                let matcher = if colour_used {
+                    let w = COLOUR_WEIGHT * object.diagonal();
+                    colour_sub = icp::Matcher::colour_tree(&sub, w);
+                    icp::Matcher::Colour {
+                        tree: &colour_sub,
+                        weight: w,
+                    }
+                } else {
+                    icp::Matcher::Geometry(&sub_tree)
+                };
+                let r = refine(
+                    &sub.points,
+                    &Target::Guidance {
+                        points: &g.points,
+                        colours: &g.colours,
+                        matcher: &matcher,
+                        keep: 0.8,
+                    },
+                    t,
+                    f,
+                    unit,
+                    &o.refine,
+                );
+                t = r.transform;
+                method.push_str("+collision_refine");
+                refinement = Some(RefineReport::from(&r));
+            }
+        }
+        if o.method.refines() && rank + 1 < order.len() {
+            let placed: Mesh = inp.visual.geometry().transformed(&t.matrix());
+            let fld = field.get_or_insert_with(|| AnchorField::new(&[], 32));
+            fld.push(&placed, 32);
+        }
+        results.push(ObjectResult {
+            name: inp.name.clone(),
+            transform: t,
+            method,
+            silhouette_area: areas[i],
+            initial_scale: scale0,
+            score,
+            icp_rms: rms,
+            hypotheses: n_hyp,
+            colour_used,
+            refinement,
+        });
+    }
+    Ok(Composition {
+        anchor: inputs[order[0]].name.clone(),
+        objects: results,
+        scene_diagonal: unit,
+    })
+}
+
+/// What [`fix_penetration`] did to one object.
+#[derive(Clone, Debug, Serialize)]
+pub struct FixReport {
+    pub name: String,
+    /// Largest penetration of the object's surface samples into the objects placed before it,
+    /// before and after (scene units).
+    pub penetration_before: f64,
+    pub penetration_after: f64,
+    /// Largest displacement of a surface sample (scene units).
+    pub moved: f64,
+}
+
+/// Remove slight interpenetration from a scene's given poses while keeping every object as
+/// close as possible to its pose: the collision-aware refinement (step 5) with the data term
+/// pulling each surface sample back to where the given pose put it. Objects are taken in order
+/// (fixed objects first, then by decreasing bounding-box volume); the first stays put and each
+/// next one is refined against all those before it. Objects that do not penetrate are untouched.
+pub fn fix_penetration(scene: &mut crate::scene::Scene, o: &RefineOptions) -> Vec<FixReport> {
+    let placed: Vec<Mesh> = scene
+        .objects
+        .iter()
+        .map(|ob| ob.visual.geometry().transformed(&ob.pose.matrix()))
+        .collect();
+    let vol = |m: &Mesh| m.aabb().map(|b| b.extents().product()).unwrap_or(0.0);
+    let mut order: Vec<usize> = (0..placed.len()).collect();
+    order.sort_by(|&a, &b| {
+        scene.objects[b]
+            .physical
+            .fixed
+            .cmp(&scene.objects[a].physical.fixed)
+            .then(vol(&placed[b]).total_cmp(&vol(&placed[a])))
+            .then(a.cmp(&b))
+    });
+    let unit = placed
+        .iter()
+        .filter_map(|m| m.aabb())
+        .reduce(|a, b| a.union(&b))
+        .map(|b| b.diagonal())
+        .unwrap_or(1.0);
+    let mut field = AnchorField::new(&[], 40);
+    let mut out = Vec::new();
+    for (rank, &i) in order.iter().enumerate() {
+        if rank > 0 {
+            let ob = &scene.objects[i];
+            let pts = Cloud::sample(&ob.visual, 1500, 0x5EED).points;
+            let r = refine(&pts, &Target::InitialPose, ob.pose, &field, unit, o);
+            let report = FixReport {
+                name: ob.name.clone(),
+                penetration_before: r.penetration_before,
+                penetration_after: if r.penetration_before > 0.0 {
+                    r.penetration_after
+                } else {
+                    0.0
+                },
+                moved: if r.penetration_before > 0.0 {
+                    r.moved
+                } else {
+                    0.0
+                },
+            };
+            if r.penetration_before > 0.0 {
+                scene.objects[i].pose = r.transform;
+            }
+            out.push(report);
+        }
+        if rank + 1 < order.len() {
+            let ob = &scene.objects[i];
+            field.push(&ob.visual.geometry().transformed(&ob.pose.matrix()), 40);
+        }
+    }
+    out
+}
