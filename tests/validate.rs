@@ -94,6 +94,14 @@ fn mujoco_and_pybullet_agree_with_the_rapier_verdict_on_every_fixture() {
         let mj = python_json("check_mujoco.py", &[dir.to_str().unwrap()]);
         let pb = python_json("check_pybullet.py", &[dir.to_str().unwrap()]);
         let name = scene.file_name().unwrap().to_string_lossy().to_string();
+        // fixtures/README.md: the fail_* scenes are built to fail, every other one to pass.
+        assert_eq!(
+            o.code == 0,
+            !name.starts_with("fail_"),
+            "{name}: exit {} against its designed outcome: {}",
+            o.code,
+            o.report["validation"]["checks"]
+        );
         let failed = rapier_failed(&o.report);
         if failed.is_empty() {
             // Dynamic pass: nothing moves and nothing overlaps in the other engines either.

@@ -646,8 +646,12 @@ fn vertex_depth(a: &Surface, b: &Surface) -> f64 {
 /// could rest on.
 const CONTACT_DEV: f64 = 0.1;
 
-/// Refine where the neighbours are, before any cut: a patch hull whose bulge (its chord over a
-/// concave side, up to the tolerance) could reach a neighbour's hull is split, worst first, while
+/// Least upward component of the normal from a patch to a neighbour resting on it (about 25°
+/// from vertical).
+const SUPPORT_NZ: f64 = 0.9;
+
+/// Refine where the neighbours rest, before any cut: a patch hull whose bulge (its chord over a
+/// concave side, up to the tolerance) could reach a neighbour resting on it is split, worst first, while
 /// the object's budget lasts, until its deviation is below `CONTACT_DEV` of the tolerance. A
 /// ball on a bowl's flat floor otherwise rests on the chords of the two patches that span the
 /// floor and the rising wall: a groove 0.1–0.3 mm above the floor, tilted 1–2°, in which each
@@ -681,10 +685,16 @@ fn contact_splits(
                     let Some(hp) = polyhedron(&part.hull) else {
                         continue;
                     };
+                    // The neighbour rests on this patch: it is within reach, above it along a
+                    // near-vertical normal (scenes are Z-up by now). Side and leaning contacts
+                    // (a pen on a mug's rim) are left to the cuts: splitting the rim under a
+                    // leaning pen let it roll 150° about its axis in Rapier.
                     let near = objs[other].parts.iter().any(|q| {
                         part.hull.aabb.intersects(&q.hull.aabb, reach)
-                            && polyhedron(&q.hull)
-                                .is_some_and(|hq| geom::distance(&hp, &hq) < reach)
+                            && polyhedron(&q.hull).is_some_and(|hq| {
+                                geom::separation(&hp, &hq)
+                                    .is_some_and(|(d, n, _, _)| d < reach && n.z >= SUPPORT_NZ)
+                            })
                     });
                     if near {
                         worst = Some((part.dev, o, k));
