@@ -22,6 +22,7 @@ pub mod pipeline;
 pub mod pose;
 pub mod prepare;
 pub mod report;
+pub mod rng;
 pub mod scene;
 pub mod shapes;
 pub mod validate;

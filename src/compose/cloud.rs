@@ -1,8 +1,8 @@
 //! Point clouds sampled from visual meshes: area-uniform surface points with face normals and
 //! colours (texture looked up at the point's UV, times the material's base colour).
 
-use super::rng::Rng;
 use crate::mesh::{triangle_area, VisualMesh, P3, V3};
+use crate::rng::Rng;
 use nalgebra::Matrix4;
 
 /// Surface samples of one mesh.
@@ -84,13 +84,13 @@ impl Cloud {
             .collect();
         out.points.reserve(n);
         for k in 0..n {
-            let target = (k as f64 + rng.f64()) / n as f64 * total;
+            let target = (k as f64 + rng.next_f64()) / n as f64 * total;
             let j = cum.partition_point(|&c| c < target).min(tris.len() - 1);
             let (pi, ti) = tris[j];
             let part = &mesh.parts[pi];
             let t = part.triangles[ti];
             let [a, b, c] = t.map(|i| part.positions[i as usize]);
-            let (mut r1, mut r2) = (rng.f64(), rng.f64());
+            let (mut r1, mut r2) = (rng.next_f64(), rng.next_f64());
             if r1 + r2 > 1.0 {
                 r1 = 1.0 - r1;
                 r2 = 1.0 - r2;

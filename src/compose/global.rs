@@ -7,9 +7,9 @@ use super::features::{fpfh, match_features};
 use super::icp::{trimmed_icp, umeyama, IcpOptions, Matcher};
 use super::kdtree::KdTree;
 use super::obb::{axis_permutations, Obb};
-use super::rng::Rng;
 use crate::mesh::P3;
 use crate::pose::Similarity;
+use crate::rng::Rng;
 use nalgebra::{Rotation3, UnitQuaternion};
 
 /// One registration problem: the object's samples (its own frame) and the guidance part's

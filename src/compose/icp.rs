@@ -168,7 +168,7 @@ pub fn trimmed_icp(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::compose::rng::Rng;
+    use crate::rng::Rng;
 
     #[test]
     fn umeyama_recovers_a_known_similarity_exactly() {

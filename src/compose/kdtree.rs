@@ -195,13 +195,13 @@ impl<const D: usize> KdTreeN<D> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::compose::rng::Rng;
+    use crate::rng::Rng;
 
     #[test]
     fn nearest_and_radius_match_brute_force() {
         let mut rng = Rng::new(3);
         let pts: Vec<P3> = (0..2000)
-            .map(|_| P3::new(rng.f64(), rng.f64() * 2.0, rng.f64() * 0.5))
+            .map(|_| P3::new(rng.next_f64(), rng.next_f64() * 2.0, rng.next_f64() * 0.5))
             .collect();
         let t = KdTree::new(&pts);
         let mut out = Vec::new();

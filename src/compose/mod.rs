@@ -26,7 +26,6 @@ pub mod icp;
 pub mod kdtree;
 pub mod obb;
 pub mod refine;
-pub mod rng;
 pub mod sdf;
 pub mod synth;
 

@@ -162,7 +162,7 @@ mod tests {
         let r = 0.05;
         let sphere = crate::shapes::uv_sphere(r, 48, 96);
         let f = AnchorField::new(&[sphere], 24);
-        let mut rng = crate::compose::rng::Rng::new(5);
+        let mut rng = crate::rng::Rng::new(5);
         for _ in 0..300 {
             let p = P3::new(
                 rng.range(-0.08, 0.08),

@@ -7,12 +7,12 @@
 //! The truth of object i is `frame ∘ pose_i`: object frame → guidance frame.
 
 use super::kdtree::KdTree;
-use super::rng::Rng;
 use super::ObjectInput;
 use crate::error::Result;
 use crate::io::Limits;
 use crate::mesh::{triangle_area, VisualMesh, VisualPart, P3, V3};
 use crate::pose::Similarity;
+use crate::rng::Rng;
 use nalgebra::{UnitQuaternion, Vector3};
 use std::collections::BTreeMap;
 use std::path::Path;

@@ -74,6 +74,7 @@ mod inside;
 mod tests;
 
 use crate::mesh::{Mesh, P3};
+use crate::rng::Rng;
 use bvh::{Bb, Bvh};
 use geom::V;
 use inside::{Hull, RayMesh};
@@ -376,23 +377,6 @@ pub struct ScenePair {
     pub b: usize,
     #[serde(flatten)]
     pub metrics: PairMetrics,
-}
-
-/// SplitMix64: small, fast, and good enough for uniform coordinates.
-struct Rng(u64);
-
-impl Rng {
-    fn next_u64(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^ (z >> 31)
-    }
-    /// Uniform in [0, 1).
-    fn next_f64(&mut self) -> f64 {
-        (self.next_u64() >> 11) as f64 * (1.0 / (1u64 << 53) as f64)
-    }
 }
 
 /// How the points of one axis are laid out in columns.

@@ -4,6 +4,7 @@
 
 use crate::decompose::Hull;
 use crate::mesh::{to_dvec, triangle_area, Aabb, Mesh, P3, V3};
+use crate::rng::Rng;
 use parry3d_f64::math::{Pose, Vector};
 use parry3d_f64::query::{PointQuery, Ray, RayCast};
 use parry3d_f64::shape::{ConvexPolyhedron, TriMesh, TriMeshFlags};
@@ -110,23 +111,6 @@ impl Surface {
     }
 }
 
-/// SplitMix64: a tiny deterministic generator for sampling.
-pub struct SplitMix(pub u64);
-
-impl SplitMix {
-    pub fn next_u64(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^ (z >> 31)
-    }
-    /// Uniform in [0, 1).
-    pub fn next_f64(&mut self) -> f64 {
-        (self.next_u64() >> 11) as f64 / (1u64 << 53) as f64
-    }
-}
-
 /// `n` points on a triangle set, stratified by area (deterministic for a given `seed`).
 pub fn sample_triangles(tris: &[[P3; 3]], n: usize, seed: u64) -> Vec<P3> {
     let areas: Vec<f64> = tris.iter().map(triangle_area).collect();
@@ -134,7 +118,7 @@ pub fn sample_triangles(tris: &[[P3; 3]], n: usize, seed: u64) -> Vec<P3> {
     if n == 0 || tris.is_empty() || !(total > 0.0) {
         return Vec::new();
     }
-    let mut rng = SplitMix(seed);
+    let mut rng = Rng(seed);
     let mut out = Vec::with_capacity(n);
     let mut acc = 0.0;
     let mut k = 0usize;

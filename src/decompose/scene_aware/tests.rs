@@ -283,7 +283,7 @@ fn cone_pieces_are_exactly_the_hull() {
     // a patch outline is not convex as seen from the centre, so volumes do not simply add up).
     let sum: f64 = pieces.iter().map(|p| p.0.volume).sum();
     assert!(sum >= full.volume * (1.0 - 1e-12));
-    let mut rng = geom::SplitMix(7);
+    let mut rng = crate::rng::Rng(7);
     let mut inside = 0;
     for _ in 0..20_000 {
         let q = P3::new(

@@ -1,11 +1,13 @@
-//! A small deterministic random generator (SplitMix64): the same seed gives the same stream on
-//! every platform and thread count, so every stage of `compose` is reproducible.
+//! SplitMix64: a small deterministic random generator. The same seed gives the same stream on
+//! every platform and thread count, which keeps sampling (metrics, decomposition, composition)
+//! reproducible byte for byte.
 
-/// SplitMix64.
+/// SplitMix64; the field is the raw state (`Rng(s)` starts the stream right after `s`).
 #[derive(Clone, Debug)]
-pub struct Rng(u64);
+pub struct Rng(pub u64);
 
 impl Rng {
+    /// A generator whose state is the seed mixed with the golden ratio (so seed 0 is fine).
     pub fn new(seed: u64) -> Rng {
         Rng(seed ^ 0x9E37_79B9_7F4A_7C15)
     }
@@ -17,12 +19,12 @@ impl Rng {
         z ^ (z >> 31)
     }
     /// Uniform in [0, 1).
-    pub fn f64(&mut self) -> f64 {
+    pub fn next_f64(&mut self) -> f64 {
         (self.next_u64() >> 11) as f64 / (1u64 << 53) as f64
     }
     /// Uniform in [a, b).
     pub fn range(&mut self, a: f64, b: f64) -> f64 {
-        a + (b - a) * self.f64()
+        a + (b - a) * self.next_f64()
     }
     /// Uniform integer in [0, n).
     pub fn below(&mut self, n: usize) -> usize {
@@ -30,13 +32,13 @@ impl Rng {
     }
     /// Standard normal (Box–Muller).
     pub fn normal(&mut self) -> f64 {
-        let u = self.f64().max(1e-300);
-        let v = self.f64();
+        let u = self.next_f64().max(1e-300);
+        let v = self.next_f64();
         (-2.0 * u.ln()).sqrt() * (2.0 * std::f64::consts::PI * v).cos()
     }
     /// A uniformly random rotation (Shoemake).
     pub fn rotation(&mut self) -> nalgebra::UnitQuaternion<f64> {
-        let (u1, u2, u3) = (self.f64(), self.f64(), self.f64());
+        let (u1, u2, u3) = (self.next_f64(), self.next_f64(), self.next_f64());
         let tau = 2.0 * std::f64::consts::PI;
         let q = nalgebra::Quaternion::new(
             (u1).sqrt() * (tau * u3).cos(),
