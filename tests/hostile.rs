@@ -6,6 +6,7 @@
 //! (`bad_inputs_exit_2_with_one_line_and_no_output`) are not repeated.
 
 mod batch_data;
+use batch_data::obj_text;
 mod common;
 
 use common::*;
@@ -157,18 +158,6 @@ fn write_manifest(d: &Path, objects: Value) {
         .unwrap(),
     )
     .unwrap();
-}
-
-/// OBJ text of a mesh (1-based indices).
-fn obj_text(m: &Mesh) -> String {
-    let mut s = String::new();
-    for v in &m.vertices {
-        s += &format!("v {} {} {}\n", v.x, v.y, v.z);
-    }
-    for t in &m.triangles {
-        s += &format!("f {} {} {}\n", t[0] + 1, t[1] + 1, t[2] + 1);
-    }
-    s
 }
 
 fn box_obj() -> String {

@@ -210,7 +210,8 @@ fn write_sample(dir: &Path, category: &str, s: &TwoObjects) {
     .unwrap();
 }
 
-fn obj_text(m: &Mesh) -> String {
+/// OBJ text of a mesh (1-based indices).
+pub fn obj_text(m: &Mesh) -> String {
     let mut s = String::new();
     for v in &m.vertices {
         s += &format!("v {} {} {}\n", v.x, v.y, v.z);
