@@ -663,6 +663,8 @@ fn contact_splits(
     mesh_pen: &[Vec<f64>],
     opts: &DecomposeOptions,
 ) {
+    // Parts that cannot be split; indices stay valid (a split replaces part k and appends).
+    let mut unsplittable: Vec<(usize, usize)> = Vec::new();
     for _ in 0..opts.max_hulls {
         let mut worst: Option<(f64, usize, usize)> = None;
         for &(a, b) in pairs {
@@ -677,6 +679,7 @@ fn contact_splits(
                 for (k, part) in obj.parts.iter().enumerate() {
                     if part.tris.len() < 4
                         || part.dev <= CONTACT_DEV * p.tol
+                        || unsplittable.contains(&(o, k))
                         || worst.is_some_and(|w| (w.0, w.1, w.2) >= (part.dev, o, k))
                     {
                         continue;
@@ -714,11 +717,7 @@ fn contact_splits(
                 obj.parts.push(y);
                 obj.report.neighbour_splits += 1;
             }
-            // Unsplittable: mark it done by pretending it is within the contact tolerance.
-            None => {
-                let t = CONTACT_DEV * p.tol;
-                objs[o].parts[k].dev = t;
-            }
+            None => unsplittable.push((o, k)),
         }
     }
 }
