@@ -56,6 +56,7 @@
 pub mod geom;
 pub mod metrics;
 pub mod patches;
+mod rebalance;
 
 use super::{cache, DecomposeOptions, Decomposer, Hull};
 use crate::error::Result;
@@ -68,7 +69,7 @@ use std::sync::Mutex;
 /// Engine name, recorded in reports and in the cache key.
 pub const NAME: &str = "scene_aware";
 /// Bumped whenever the output for the same input changes (invalidates the cache).
-pub const VERSION: u32 = 2;
+pub const VERSION: u32 = 3;
 
 /// What happened to one object.
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
@@ -79,6 +80,10 @@ pub struct ObjectReport {
     pub convex_shortcut: bool,
     /// Patch splits made to meet the tolerance.
     pub quality_splits: usize,
+    /// Rounds of the rebalancing (merge two adjacent patches, split the worst) that lowered the
+    /// worst deviation once the budget was spent.
+    #[serde(default)]
+    pub rebalance_rounds: usize,
     /// Patch splits made because a hull met a neighbour.
     pub neighbour_splits: usize,
     /// Plane cuts against neighbours that removed only bulge (no surface vertex).
@@ -568,8 +573,9 @@ fn split(
         .map(|(_, x)| x)
 }
 
-/// Decompose one object alone. `budget`: most hulls the quality loop may use.
-fn decompose_alone(mesh: &Mesh, opts: &DecomposeOptions, budget: usize) -> Obj {
+/// Decompose one object alone. `budget`: most hulls the quality loop may use; `rounds`: most
+/// rebalancing rounds once it is spent (see [`rebalance`]).
+fn decompose_alone(mesh: &Mesh, opts: &DecomposeOptions, budget: usize, rounds: usize) -> Obj {
     let surf = Surface::new(mesh);
     let Some(s) = surf.as_ref() else {
         return Obj {
@@ -616,6 +622,9 @@ fn decompose_alone(mesh: &Mesh, opts: &DecomposeOptions, budget: usize) -> Obj {
             }
             None => unsplittable[w] = true,
         }
+    }
+    if parts.len() >= budget {
+        report.rebalance_rounds = rebalance::rebalance(s, &feat, &p, opts, &mut parts, rounds);
     }
     Obj {
         parts,
@@ -756,7 +765,7 @@ pub fn decompose_scene(
             } else {
                 opts.max_hulls
             };
-            decompose_alone(m, opts, budget.max(1))
+            decompose_alone(m, opts, budget.max(1), budget)
         })
         .collect();
     // Meshes' own interpenetration.
