@@ -364,6 +364,42 @@ pub fn rounded_rect(hx: f64, hy: f64, r: f64, segments: usize, z: f64) -> Vec<P3
     pts
 }
 
+/// An open shelf (an étagère) standing on z = 0, centred on the z axis: two side panels
+/// `board` thick, `depth` deep (along y) and `height` tall at x = ±(width/2 − board/2), and one
+/// horizontal board per entry of `levels` (the z of its top face) spanning the inner width
+/// `width − 2·board`, `board` thick, set back 5 mm from the front and the back edges. Every
+/// piece is its own closed box; the boards' ends touch the panels' inner faces, where no
+/// vertices are shared (the boards' corners lie inside the panels' faces), so the mesh is
+/// closed and its volume is the sum of the boxes'.
+pub fn shelf(width: f64, depth: f64, height: f64, board: f64, levels: &[f64]) -> Mesh {
+    let inset = 0.005;
+    assert!(width > 2.0 * board && depth > 2.0 * inset);
+    let mut m = Mesh::new(Vec::new(), Vec::new());
+    let mut put = |ext: V3, c: V3| {
+        let b = cuboid(ext).transformed(&nalgebra::Translation3::from(c).to_homogeneous());
+        m.append(&b);
+    };
+    for sx in [-1.0, 1.0] {
+        put(
+            V3::new(board, depth, height),
+            V3::new(sx * (width - board) / 2.0, 0.0, height / 2.0),
+        );
+    }
+    for &top in levels {
+        assert!(top - board > 0.0 && top < height, "board inside the panels");
+        put(
+            V3::new(width - 2.0 * board, depth - 2.0 * inset, board),
+            V3::new(0.0, 0.0, top - board / 2.0),
+        );
+    }
+    m
+}
+
+/// Volume of [`shelf`].
+pub fn shelf_volume(width: f64, depth: f64, height: f64, board: f64, levels: usize) -> f64 {
+    2.0 * board * depth * height + levels as f64 * (width - 2.0 * board) * (depth - 0.01) * board
+}
+
 /// A flat tray standing on z = 0, centred on the z axis: outer footprint `extents[0] × extents[1]`
 /// with corners rounded at radius `2·wall` (4 segments each), floor plate and vertical rim walls
 /// `wall` thick, rim rising `rim_height` above the floor's top (total height `wall + rim_height`).
@@ -698,6 +734,20 @@ mod tests {
         assert!((m.signed_volume() - 6.0).abs() < 1e-12);
         assert!((m.area() - 22.0).abs() < 1e-12);
         assert!(m.is_closed());
+    }
+
+    #[test]
+    fn shelf_is_closed_with_the_boxes_volume() {
+        let (w, d, h, t) = (0.4, 0.25, 0.6, 0.018);
+        let m = shelf(w, d, h, t, &[0.05, 0.3, 0.55]);
+        assert!(m.is_closed());
+        // By hand: two panels 0.018 x 0.25 x 0.6, three boards 0.364 x 0.24 x 0.018.
+        let by_hand = 2.0 * 0.018 * 0.25 * 0.6 + 3.0 * 0.364 * 0.24 * 0.018;
+        assert!((m.signed_volume() - by_hand).abs() < 1e-12);
+        assert!((shelf_volume(w, d, h, t, 3) - by_hand).abs() < 1e-12);
+        let b = m.aabb().unwrap();
+        assert!((b.min.z).abs() < 1e-12 && (b.max.z - h).abs() < 1e-12);
+        assert!((b.extents().x - w).abs() < 1e-12 && (b.extents().y - d).abs() < 1e-12);
     }
 
     #[test]

@@ -320,3 +320,39 @@ fn ball_rests_at_the_bottom_of_the_bowl_in_mujoco_after_2_s() {
         err / MM
     );
 }
+
+/// From the shelf fixture's construction (fixtures/shelf_item/README.md): the box stands on the
+/// middle board, whose top face is at z = 300 mm, at (x, y) = (30, 10) mm; its centre rests
+/// 50 mm above the board (350.75 mm in the composed pose minus the 0.75 mm gap). MuJoCo must
+/// find no initial contact deeper than 0.1 mm and, after 2 s, the box still in the shelf.
+#[test]
+fn box_stays_on_the_middle_shelf_board_in_mujoco_after_2_s() {
+    let o = export_validated(&root().join("fixtures/shelf_item"));
+    assert_eq!(o.code, 0, "{}", o.report["validation"]["checks"]);
+    let dir = o.out.path().join("out");
+    let mj = python_json(
+        "check_mujoco.py",
+        &[dir.to_str().unwrap(), "--seconds", "2"],
+    );
+    assert!(
+        mj["initial_penetration"].as_f64().unwrap() <= 0.1 * MM,
+        "{}",
+        mj["initial_penetration"]
+    );
+    let bx: Vec<f64> = mj["final_pos"]["box"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|x| x.as_f64().unwrap())
+        .collect();
+    let expected = [0.030, 0.010, 0.350];
+    let err = (0..3)
+        .map(|k| (bx[k] - expected[k]).powi(2))
+        .sum::<f64>()
+        .sqrt();
+    assert!(
+        err <= MM,
+        "box at {bx:?}, expected {expected:?}: {:.3} mm off",
+        err / MM
+    );
+}

@@ -222,6 +222,24 @@ fn box_on_tray_hulls_apart() {
 }
 
 #[test]
+fn box_on_shelf_hulls_apart_and_the_shelf_stays_open() {
+    check_scene(&fixture("shelf_item"));
+    // From fixtures/shelf_item/README.md: the cavity between the middle board (top face at
+    // z = 300 mm) and the top board (bottom face at 532 mm) spans x in ±182 mm. Points across
+    // it, in front of, at and behind the box's place, are outside every hull of the shelf.
+    let meshes = world_meshes(&fixture("shelf_item"));
+    let (hulls, _) = decompose_scene(&[&meshes[0]], &opts());
+    for x in [-0.17, -0.09, 0.0, 0.09, 0.17] {
+        for y in [-0.1, 0.0, 0.1] {
+            for z in [0.31, 0.42, 0.52] {
+                let p = P3::new(x, y, z);
+                assert!(hulls[0].iter().all(|h| !h.contains(&p)), "{p:?} filled");
+            }
+        }
+    }
+}
+
+#[test]
 fn real_scenes_hulls_apart() {
     let Some(shared) = shared() else {
         eprintln!("shared datasets not present: skipped");
