@@ -11,9 +11,11 @@
 //! among the patches touched goes down, so the maximum over the object never goes up. The
 //! loop stops at the first round that does not help, or after `rounds`.
 //!
-//! Patches that face up (a quarter of their area or more within about 25° of +Z: a floor, a
-//! shelf, a rim) are never merged, so what an object may be put on stays as refined as the
-//! quality loop left it. Scenes are Z-up by the time they are decomposed.
+//! A merge may not lift the hull above the patches' up-facing triangles (a floor, a shelf)
+//! more than the two hulls did (nor above `CONTACT_DEV` of the tolerance), so what an object
+//! may be put on stays as flat as the quality loop left it; a rim merged into the wall
+//! segment under it is fine, since the merged hull's top is the rim. Scenes are Z-up by the
+//! time they are decomposed.
 //!
 //! Applied to objects without neighbours only (see `decompose_scene`): on the `ball_bowl`
 //! scene, a rebalanced bowl let MuJoCo roll the ball 0.6 mm while Rapier held it.
@@ -23,7 +25,7 @@
 
 use super::geom::Surface;
 use super::patches::Features;
-use super::{build_part, split, Params, Part, SUPPORT_NZ};
+use super::{build_part, split, Params, Part, CONTACT_DEV, SUPPORT_NZ};
 use crate::decompose::DecomposeOptions;
 use rayon::prelude::*;
 use std::collections::BTreeMap;
@@ -41,12 +43,18 @@ pub(super) fn rebalance(
     let mut next_id = parts.len() as u64;
     let mut merged: BTreeMap<(u64, u64), Option<Part>> = BTreeMap::new();
     let mut kept = 0;
-    for _ in 0..rounds {
+    // Patches whose best split does not go below their own deviation (by id): skipped, and the
+    // next worst is tried instead.
+    let mut stuck: Vec<u64> = Vec::new();
+    for _ in 0..2 * rounds {
+        if kept >= rounds {
+            break;
+        }
         if parts.len() < 3 {
             break;
         }
         let Some(w) = (0..parts.len())
-            .filter(|&i| parts[i].tris.len() >= 2)
+            .filter(|&i| parts[i].tris.len() >= 2 && !stuck.contains(&ids[i]))
             .max_by(|&i, &j| parts[i].dev.total_cmp(&parts[j].dev).then(j.cmp(&i)))
         else {
             break;
@@ -55,13 +63,8 @@ pub(super) fn rebalance(
         if worst <= p.tol {
             break;
         }
-        // Adjacent pairs (sharing a mesh vertex), w excluded, in index order. Patches that
-        // something could rest on are not merged: a merged hull bridges from them to the
-        // next patch, and an object put on the floor later would rest on that chord.
-        let pairs: Vec<(usize, usize)> = adjacent_pairs(s, parts, w)
-            .into_iter()
-            .filter(|&(i, j)| !supports(s, &parts[i]) && !supports(s, &parts[j]))
-            .collect();
+        // Adjacent pairs (sharing a mesh vertex), w excluded, in index order.
+        let pairs: Vec<(usize, usize)> = adjacent_pairs(s, parts, w);
         let missing: Vec<(usize, usize)> = pairs
             .iter()
             .copied()
@@ -79,23 +82,64 @@ pub(super) fn rebalance(
         for (&(i, j), b) in missing.iter().zip(built) {
             merged.insert((ids[i], ids[j]), b);
         }
+        // A merge may not lift the hull above an up-facing surface (a floor, where something
+        // may be put later) more than the two hulls did: it would rest on the merged chord.
+        let allowed = |i: usize, j: usize, m: &Part| {
+            lift(s, &m.hull, m.tris.iter())
+                <= lift(s, &parts[i].hull, parts[i].tris.iter())
+                    .max(lift(s, &parts[j].hull, parts[j].tris.iter()))
+                    .max(CONTACT_DEV * p.tol)
+        };
         let best = pairs
             .iter()
             .filter_map(|&(i, j)| {
                 let m = merged.get(&(ids[i], ids[j]))?.as_ref()?;
-                Some((m.dev, i, j))
+                allowed(i, j, m).then_some((m.dev, i, j))
             })
             .min_by(|a, b| a.0.total_cmp(&b.0).then((a.1, a.2).cmp(&(b.1, b.2))));
-        let Some((m_dev, i, j)) = best else { break };
-        if m_dev >= worst {
-            break;
-        }
-        let Some((a, b)) = split(s, f, p, opts, &parts[w]) else {
-            break;
+        let up = |k: usize| lift(s, &parts[k].hull, parts[k].tris.iter());
+        // Move 1: merge the best pair, split w.
+        let halves = best
+            .filter(|&(m_dev, _, _)| m_dev < worst)
+            .and_then(|_| split(s, f, p, opts, &parts[w]))
+            .filter(|(a, b)| a.dev.max(b.dev) < worst);
+        let Some((a, b)) = halves else {
+            // Move 2: move w's border with one of its neighbours (merge the two, split again)
+            // when that brings both below w's deviation.
+            let relaxed = neighbours(s, parts, w)
+                .into_par_iter()
+                .filter_map(|j| {
+                    let mut tris = parts[w].tris.clone();
+                    tris.extend_from_slice(&parts[j].tris);
+                    tris.sort_unstable();
+                    let both = Part {
+                        tris,
+                        cuts: parts[w].cuts.clone(),
+                        ..parts[w].clone()
+                    };
+                    let (a, b) = split(s, f, p, opts, &both)?;
+                    let top = up(w).max(up(j)).max(CONTACT_DEV * p.tol);
+                    let ok = a.dev.max(b.dev) < worst
+                        && lift(s, &a.hull, a.tris.iter()) <= top
+                        && lift(s, &b.hull, b.tris.iter()) <= top;
+                    ok.then_some((a.dev.max(b.dev), j, a, b))
+                })
+                .min_by(|x, y| x.0.total_cmp(&y.0).then(x.1.cmp(&y.1)));
+            match relaxed {
+                Some((_, j, a, b)) => {
+                    parts[w] = a;
+                    parts[j] = b;
+                    for k in [w, j] {
+                        ids[k] = next_id;
+                        next_id += 1;
+                    }
+                    kept += 1;
+                }
+                None => stuck.push(ids[w]),
+            }
+            continue;
         };
-        if a.dev.max(b.dev) >= worst {
-            break;
-        }
+        let (_, i, j) = best.expect("move 1 needs a merge");
         let m = merged
             .remove(&(ids[i], ids[j]))
             .flatten()
@@ -113,17 +157,47 @@ pub(super) fn rebalance(
     kept
 }
 
-/// Whether a quarter or more of the patch's area faces up (normal within about 25° of +Z).
-fn supports(s: &Surface, part: &Part) -> bool {
-    let (mut up, mut all) = (0.0, 0.0);
-    for &t in &part.tris {
-        let a = s.tri_area[t as usize];
-        all += a;
-        if s.tri_normal[t as usize].z >= SUPPORT_NZ {
-            up += a;
+/// How far the hull's surface lies above the patch's up-facing triangles (normal within
+/// about 25° of +Z): the largest distance, straight up from a triangle's centroid, to where
+/// it leaves the hull. 0 when the patch has none.
+fn lift<'a>(s: &Surface, h: &crate::decompose::Hull, tris: impl Iterator<Item = &'a u32>) -> f64 {
+    let mut worst: f64 = 0.0;
+    for &t in tris {
+        if s.tri_normal[t as usize].z < SUPPORT_NZ {
+            continue;
+        }
+        let c = s.tri_centroid[t as usize];
+        let exit = h
+            .planes
+            .iter()
+            .filter(|(n, _)| n.z > 1e-9)
+            .map(|(n, d)| (d - n.dot(&c.coords)) / n.z)
+            .fold(f64::INFINITY, f64::min);
+        if exit.is_finite() {
+            worst = worst.max(exit);
         }
     }
-    all > 0.0 && up >= 0.25 * all
+    worst
+}
+
+/// Patches sharing a mesh vertex with patch `w`, ascending.
+fn neighbours(s: &Surface, parts: &[Part], w: usize) -> Vec<usize> {
+    let mut mine = vec![false; s.mesh.vertices.len()];
+    for &t in &parts[w].tris {
+        for v in s.mesh.triangles[t as usize] {
+            mine[v as usize] = true;
+        }
+    }
+    (0..parts.len())
+        .filter(|&k| {
+            k != w
+                && parts[k].tris.iter().any(|&t| {
+                    s.mesh.triangles[t as usize]
+                        .iter()
+                        .any(|&v| mine[v as usize])
+                })
+        })
+        .collect()
 }
 
 /// Pairs `(i, j)`, `i < j`, of patches sharing a mesh vertex, neither of them `skip`.
