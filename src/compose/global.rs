@@ -167,32 +167,55 @@ impl GlobalRegistration for FpfhRansac {
     }
 }
 
-/// How well a pose explains the guidance: the fraction of guidance points with an object point
-/// within `tau` (colour-weighted when `colour`), plus half the fraction of object points with a
-/// guidance point within `tau` (penalises poses that push the object where the guidance is empty).
-pub fn score(
-    p: &Problem,
-    t: &Similarity,
-    colour: bool,
-    probe_g: &[usize],
-    probe_o: &[usize],
-) -> f64 {
+/// The three parts of a pose's fit, over probe subsets of the guidance and object samples.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Fit {
+    /// Fraction of guidance points with an object point within τ.
+    pub guidance_explained: f64,
+    /// The same, each inlier weighted by colour agreement (Gaussian, σ = 0.12 per channel).
+    pub colour_explained: f64,
+    /// Fraction of object points with a guidance point within τ.
+    pub object_covered: f64,
+}
+
+impl Fit {
+    /// Fraction of the guidance explained (colour-weighted when `colour`) plus half the fraction
+    /// of the object covered: the score reported per object.
+    pub fn score(&self, colour: bool) -> f64 {
+        let fwd = if colour {
+            self.colour_explained
+        } else {
+            self.guidance_explained
+        };
+        fwd + 0.5 * self.object_covered
+    }
+
+    /// What hypotheses are ranked by: the geometric score plus, with colour, the colour score.
+    /// Colour alone is a noisy judge of scale (a lit, tinted print matches itself slightly
+    /// shifted almost as well), geometry alone cannot tell a symmetric shape's twins apart; the
+    /// sum needs both to agree.
+    pub fn rank(&self, colour: bool) -> f64 {
+        self.score(false) + if colour { self.score(true) } else { 0.0 }
+    }
+}
+
+/// The fit of pose `t` within τ = 2% of the guidance diagonal, both ways: guidance → object
+/// (does the object explain the guidance?) and object → guidance (does the pose put object
+/// surface where the guidance is empty?).
+pub fn fit(p: &Problem, t: &Similarity, probe_g: &[usize], probe_o: &[usize]) -> Fit {
     let tau = 0.02 * p.guidance_diagonal();
     let m = t.matrix();
     let inv = m.try_inverse().unwrap_or_else(nalgebra::Matrix4::identity);
-    let mut fwd = 0.0;
+    let (mut geo, mut col) = (0.0, 0.0);
     for &gi in probe_g {
         let q = inv.transform_point(&p.guidance.points[gi]);
         if let Some((oi, d2)) = p.object_tree.nearest(&q) {
             if d2.sqrt() * t.scale < tau {
-                fwd += if colour {
-                    let a = p.guidance.colours[gi];
-                    let b = p.object.colours[oi];
-                    let d2c: f64 = (0..3).map(|k| (a[k] - b[k]).powi(2)).sum();
-                    (-d2c / (2.0 * 0.12 * 0.12)).exp()
-                } else {
-                    1.0
-                };
+                geo += 1.0;
+                let a = p.guidance.colours[gi];
+                let b = p.object.colours[oi];
+                let d2c: f64 = (0..3).map(|k| (a[k] - b[k]).powi(2)).sum();
+                col += (-d2c / (2.0 * 0.12 * 0.12)).exp();
             }
         }
     }
@@ -205,11 +228,66 @@ pub fn score(
             }
         }
     }
-    fwd / probe_g.len().max(1) as f64 + 0.5 * back / probe_o.len().max(1) as f64
+    let ng = probe_g.len().max(1) as f64;
+    Fit {
+        guidance_explained: geo / ng,
+        colour_explained: col / ng,
+        object_covered: back / probe_o.len().max(1) as f64,
+    }
 }
 
-/// Refine every hypothesis with a short ICP, score it, return the best (pose, score) and how many
-/// hypotheses were tried.
+/// How well a pose explains the guidance: the fraction of guidance points with an object point
+/// within `tau` (colour-weighted when `colour`), plus half the fraction of object points with a
+/// guidance point within `tau` (penalises poses that push the object where the guidance is empty).
+pub fn score(
+    p: &Problem,
+    t: &Similarity,
+    colour: bool,
+    probe_g: &[usize],
+    probe_o: &[usize],
+) -> f64 {
+    fit(p, t, probe_g, probe_o).score(colour)
+}
+
+/// Every `len / n`-th index: a deterministic probe subset of about `n` of `len` points.
+pub fn probes(len: usize, n: usize) -> Vec<usize> {
+    (0..len).step_by((len / n.max(1)).max(1)).collect()
+}
+
+/// `t` preceded by the rotation `spin` about the object-frame point `c`: the object turned in
+/// place, its centre staying where `t` put it.
+pub fn spun(t: &Similarity, spin: &UnitQuaternion<f64>, c: &P3) -> Similarity {
+    let rotation = t.rotation * spin;
+    let translation = t.translation + t.scale * (t.rotation * (c.coords - spin * c.coords));
+    Similarity {
+        rotation,
+        translation,
+        ..*t
+    }
+}
+
+/// Turns of the object about its own centre tried around the best hypotheses: every 30° about
+/// each of its OBB axes (the turns a spheroid, a cylinder or a box cannot show by shape), plus
+/// `random` rotations spread over SO(3) (for shapes, like a ball, that show no axis at all).
+pub fn spins(obb: &Obb, random: usize, seed: u64) -> Vec<UnitQuaternion<f64>> {
+    let mut out = Vec::new();
+    for k in 0..3 {
+        let axis = nalgebra::Unit::new_normalize(obb.axes.column(k).into_owned());
+        for step in 1..12 {
+            out.push(UnitQuaternion::from_axis_angle(
+                &axis,
+                step as f64 * std::f64::consts::PI / 6.0,
+            ));
+        }
+    }
+    let mut rng = Rng::new(seed ^ 0x5B1A);
+    out.extend((0..random).map(|_| rng.rotation()));
+    out
+}
+
+/// Refine every hypothesis with a short ICP and rank it ([`Fit::rank`]); then turn the best
+/// few in place ([`spins`]), rank the turned poses as they are, refine the best of those too,
+/// and return the best (pose, rank) of all.
 pub fn best_hypothesis(
     p: &Problem,
     hyps: &[Similarity],
@@ -219,24 +297,42 @@ pub fn best_hypothesis(
 ) -> Option<(Similarity, f64)> {
     use rayon::prelude::*;
     let g_short = p.guidance.subsample(500);
-    let probe_g: Vec<usize> = (0..p.guidance.len())
-        .step_by((p.guidance.len() / 700).max(1))
-        .collect();
-    let probe_o: Vec<usize> = (0..p.object.len())
-        .step_by((p.object.len() / 700).max(1))
-        .collect();
+    let probe_g = probes(p.guidance.len(), 700);
+    let probe_o = probes(p.object.len(), 700);
     let short = IcpOptions {
         iterations: 20,
         ..*icp
     };
-    let results: Vec<(Similarity, f64)> = hyps
+    let refine_and_rank = |h: &Similarity| {
+        let (t, _) = trimmed_icp(&p.object.points, matcher, &g_short, *h, &short);
+        (t, fit(p, &t, &probe_g, &probe_o).rank(colour))
+    };
+    let mut results: Vec<(Similarity, f64)> = hyps.par_iter().map(refine_and_rank).collect();
+    // The best few distinct poses, turned in place and ranked on coarse probes.
+    let mut order: Vec<usize> = (0..results.len()).collect();
+    order.sort_by(|&a, &b| results[b].1.total_cmp(&results[a].1).then(a.cmp(&b)));
+    let mut bases: Vec<Similarity> = Vec::new();
+    for &i in &order {
+        let t = results[i].0;
+        if bases.len() < 2 && bases.iter().all(|b| b.rotation.angle_to(&t.rotation) > 0.2) {
+            bases.push(t);
+        }
+    }
+    let turns = spins(&p.object_obb, 60, p.seed);
+    let coarse_g = probes(p.guidance.len(), 300);
+    let coarse_o = probes(p.object.len(), 300);
+    let c = p.object_obb.center;
+    let mut turned: Vec<(Similarity, f64)> = bases
+        .iter()
+        .flat_map(|b| turns.iter().map(move |s| spun(b, s, &c)))
+        .collect::<Vec<_>>()
         .par_iter()
-        .map(|h| {
-            let (t, _) = trimmed_icp(&p.object.points, matcher, &g_short, *h, &short);
-            let s = score(p, &t, colour, &probe_g, &probe_o);
-            (t, s)
-        })
+        .map(|t| (*t, fit(p, t, &coarse_g, &coarse_o).rank(colour)))
         .collect();
+    turned.sort_by(|a, b| b.1.total_cmp(&a.1));
+    turned.truncate(6);
+    let more: Vec<(Similarity, f64)> = turned.par_iter().map(|(t, _)| refine_and_rank(t)).collect();
+    results.extend(more);
     results
         .into_iter()
         .enumerate()
