@@ -7,7 +7,7 @@ use super::features::{fpfh, match_features};
 use super::icp::{trimmed_icp, umeyama, IcpOptions, Matcher};
 use super::kdtree::KdTree;
 use super::obb::{axis_permutations, Obb};
-use crate::mesh::P3;
+use crate::mesh::{P3, V3};
 use crate::pose::Similarity;
 use crate::rng::Rng;
 use nalgebra::{Rotation3, UnitQuaternion};
@@ -285,6 +285,68 @@ pub fn spins(obb: &Obb, random: usize, seed: u64) -> Vec<UnitQuaternion<f64>> {
     out
 }
 
+/// `t` shifted so the object sits on the guidance: `iterations` translation-only ICP steps
+/// (guidance probe → nearest object sample, the worst 20% of pairs dropped, mean residual). A
+/// turned pose keeps its centre where the untouched pose had it, which for a shape that is not
+/// centred on its own middle (a fruit's flat spot, a pen's clip) is off by a few per cent.
+pub fn recentred(p: &Problem, t: &Similarity, probe_g: &[usize], iterations: usize) -> Similarity {
+    let mut t = *t;
+    let mut res: Vec<(f64, V3)> = Vec::with_capacity(probe_g.len());
+    for _ in 0..iterations {
+        let m = t.matrix();
+        let Some(inv) = m.try_inverse() else { break };
+        res.clear();
+        for &gi in probe_g {
+            let g = p.guidance.points[gi];
+            if let Some((oi, _)) = p.object_tree.nearest(&inv.transform_point(&g)) {
+                let d = g - m.transform_point(&p.object.points[oi]);
+                res.push((d.norm_squared(), d));
+            }
+        }
+        if res.is_empty() {
+            break;
+        }
+        res.sort_by(|a, b| a.0.total_cmp(&b.0));
+        let k = (res.len() * 4 / 5).max(1);
+        t.translation += res[..k].iter().fold(V3::zeros(), |a, r| a + r.1) / k as f64;
+    }
+    t
+}
+
+/// Pattern search on the rank over turns of the object about its centre: ±15°, ±7.5°, ±3.75°
+/// about the object's x, y and z axes, each step size until no turn improves the rank (at most
+/// three rounds). Returns the best pose found and its rank.
+pub fn climb_rotation(
+    p: &Problem,
+    t: Similarity,
+    rank: f64,
+    probe_g: &[usize],
+    probe_o: &[usize],
+    colour: bool,
+) -> (Similarity, f64) {
+    let c = p.object_obb.center;
+    let mut best = (t, rank);
+    for deg in [15.0f64, 7.5, 3.75] {
+        for _ in 0..3 {
+            let base = best;
+            for axis in [V3::x_axis(), V3::y_axis(), V3::z_axis()] {
+                for sign in [-1.0, 1.0] {
+                    let turn = UnitQuaternion::from_axis_angle(&axis, sign * deg.to_radians());
+                    let cand = spun(&base.0, &turn, &c);
+                    let r = fit(p, &cand, probe_g, probe_o).rank(colour);
+                    if r > best.1 {
+                        best = (cand, r);
+                    }
+                }
+            }
+            if best.1 <= base.1 {
+                break;
+            }
+        }
+    }
+    best
+}
+
 /// Refine every hypothesis with a short ICP and rank it ([`Fit::rank`]); then turn the best
 /// few in place ([`spins`]), rank the turned poses as they are, refine the best of those too,
 /// and return the best (pose, rank) of all.
@@ -318,24 +380,82 @@ pub fn best_hypothesis(
             bases.push(t);
         }
     }
-    let turns = spins(&p.object_obb, 60, p.seed);
-    let coarse_g = probes(p.guidance.len(), 300);
-    let coarse_o = probes(p.object.len(), 300);
+    // Axis turns around both bases; the SO(3) samples around the best one only (about its
+    // centre they already cover every orientation).
+    let axis_turns = spins(&p.object_obb, 0, p.seed);
+    let random_turns =
+        spins(&p.object_obb, if colour { 500 } else { 240 }, p.seed)[axis_turns.len()..].to_vec();
+    let coarse_g = probes(p.guidance.len(), 200);
+    let coarse_o = probes(p.object.len(), 200);
     let c = p.object_obb.center;
-    let mut turned: Vec<(Similarity, f64)> = bases
+    let mut candidates: Vec<Similarity> = bases
         .iter()
-        .flat_map(|b| turns.iter().map(move |s| spun(b, s, &c)))
-        .collect::<Vec<_>>()
+        .flat_map(|b| axis_turns.iter().map(move |s| spun(b, s, &c)))
+        .collect();
+    if let Some(b) = bases.first() {
+        candidates.extend(random_turns.iter().map(|s| spun(b, s, &c)));
+    }
+    let mut turned: Vec<(Similarity, f64)> = candidates
         .par_iter()
-        .map(|t| (*t, fit(p, t, &coarse_g, &coarse_o).rank(colour)))
+        .map(|t| {
+            let t = recentred(p, t, &coarse_g, 2);
+            (t, fit(p, &t, &coarse_g, &coarse_o).rank(colour))
+        })
         .collect();
     turned.sort_by(|a, b| b.1.total_cmp(&a.1));
-    turned.truncate(6);
-    let more: Vec<(Similarity, f64)> = turned.par_iter().map(|(t, _)| refine_and_rank(t)).collect();
+    // The best eight that differ by more than 20° (neighbours of one good pose rank alike).
+    let mut distinct: Vec<(Similarity, f64)> = Vec::new();
+    for &(t, r) in &turned {
+        if distinct.len() == 8 {
+            break;
+        }
+        if distinct
+            .iter()
+            .all(|d| d.0.rotation.angle_to(&t.rotation) > 20f64.to_radians())
+        {
+            distinct.push((t, r));
+        }
+    }
+    let more: Vec<(Similarity, f64)> = distinct
+        .par_iter()
+        .map(|(t, _)| refine_and_rank(t))
+        .collect();
     results.extend(more);
     results
         .into_iter()
         .enumerate()
         .max_by(|a, b| a.1 .1.total_cmp(&b.1 .1).then(b.0.cmp(&a.0)))
         .map(|(_, r)| r)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn turning_in_place_keeps_the_centre_and_composes_the_rotation() {
+        let t = Similarity {
+            scale: 1.7,
+            rotation: UnitQuaternion::from_euler_angles(-0.4, 0.9, 0.2),
+            translation: V3::new(3.0, 0.0, -1.0),
+        };
+        let c = P3::new(0.1, -0.2, 0.3);
+        let spin = UnitQuaternion::from_euler_angles(0.0, 0.0, std::f64::consts::FRAC_PI_2);
+        let s = spun(&t, &spin, &c);
+        let (m0, m1) = (t.matrix(), s.matrix());
+        assert!((m0.transform_point(&c) - m1.transform_point(&c)).norm() < 1e-12);
+        // A point turned by the spin about c first, then placed by t.
+        let q = P3::new(1.0, 0.5, -0.5);
+        let turned = c + spin * (q - c);
+        assert!((m1.transform_point(&q) - m0.transform_point(&turned)).norm() < 1e-12);
+        // 33 axis turns (11 per OBB axis) plus the random ones, none the identity.
+        let obb = crate::compose::obb::Obb {
+            center: P3::origin(),
+            axes: nalgebra::Matrix3::identity(),
+            extents: V3::new(3.0, 2.0, 1.0),
+        };
+        let turns = spins(&obb, 5, 1);
+        assert_eq!(turns.len(), 38);
+        assert!(turns.iter().all(|r| r.angle() > 0.1));
+    }
 }
