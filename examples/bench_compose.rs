@@ -8,7 +8,8 @@
 //! scale error < 3%. R_volume and max penetration (mm, in the scene's metres) are measured on the
 //! composed visual meshes with `metrics::pair_metrics`; time is per object registration.
 //!
-//! cargo run --release --example bench_compose [-- --seeds N] [--quick] [--methods full,...]
+//! cargo run --release --example bench_compose [-- --seeds N] [--seed-offset N] [--threads N]
+//!     [--only SUBSTRING] [--methods full,...] [-v]
 
 use interact3d::compose::synth::{self, TruthObject};
 use interact3d::compose::{compose, ComposeOptions, Method};
@@ -46,12 +47,27 @@ fn median(v: &[f64]) -> f64 {
 
 fn main() {
     let args: Vec<String> = std::env::args().collect();
-    let seeds: u64 = args
-        .iter()
-        .position(|a| a == "--seeds")
-        .and_then(|i| args.get(i + 1))
+    let value = |flag: &str| -> Option<&String> {
+        args.iter()
+            .position(|a| a == flag)
+            .and_then(|i| args.get(i + 1))
+    };
+    let seeds: u64 = value("--seeds").and_then(|s| s.parse().ok()).unwrap_or(2);
+    // Seeds run from 1000 + offset (guidance generator) and offset (pipeline): a different
+    // offset is a held-out set of generated guidance parts.
+    let seed_offset: u64 = value("--seed-offset")
         .and_then(|s| s.parse().ok())
-        .unwrap_or(2);
+        .unwrap_or(0);
+    if let Some(n) = value("--threads").and_then(|s| s.parse::<usize>().ok()) {
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(n.max(1))
+            .build_global()
+            .expect("thread pool");
+    }
+    // Only the scenes whose name contains one of these (comma-separated) substrings.
+    let only: Vec<String> = value("--only")
+        .map(|s| s.split(',').map(str::to_string).collect())
+        .unwrap_or_default();
     let methods: Vec<Method> = match args.iter().position(|a| a == "--methods") {
         Some(i) => args[i + 1]
             .split(',')
@@ -104,12 +120,13 @@ fn main() {
             symmetric: true,
         });
     }
+    cases.retain(|c| only.is_empty() || only.iter().any(|o| c.name.contains(o.as_str())));
     let gen = synth::SynthOptions::default();
     // rows[method][symmetric as usize]
     let mut rows = vec![[Row::default(), Row::default()]; methods.len()];
     let t_all = Instant::now();
     for case in &cases {
-        for seed in 0..seeds {
+        for seed in seed_offset..seed_offset + seeds {
             let s = synth::make(&case.objects, 1000 + seed, &gen);
             let scene_bb = s
                 .inputs
@@ -211,7 +228,7 @@ fn main() {
         }
     }
     println!(
-        "\n{} scenes × {seeds} seeds, {} threads, total {:.1} s",
+        "\n{} scenes × {seeds} seeds (from {seed_offset}), {} threads, total {:.1} s",
         cases.len(),
         rayon::current_num_threads(),
         t_all.elapsed().as_secs_f64()

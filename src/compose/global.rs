@@ -7,7 +7,7 @@ use super::features::{fpfh, match_features};
 use super::icp::{trimmed_icp, umeyama, IcpOptions, Matcher};
 use super::kdtree::KdTree;
 use super::obb::{axis_permutations, Obb};
-use crate::mesh::P3;
+use crate::mesh::{P3, V3};
 use crate::pose::Similarity;
 use crate::rng::Rng;
 use nalgebra::{Rotation3, UnitQuaternion};
@@ -167,32 +167,55 @@ impl GlobalRegistration for FpfhRansac {
     }
 }
 
-/// How well a pose explains the guidance: the fraction of guidance points with an object point
-/// within `tau` (colour-weighted when `colour`), plus half the fraction of object points with a
-/// guidance point within `tau` (penalises poses that push the object where the guidance is empty).
-pub fn score(
-    p: &Problem,
-    t: &Similarity,
-    colour: bool,
-    probe_g: &[usize],
-    probe_o: &[usize],
-) -> f64 {
+/// The three parts of a pose's fit, over probe subsets of the guidance and object samples.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Fit {
+    /// Fraction of guidance points with an object point within τ.
+    pub guidance_explained: f64,
+    /// The same, each inlier weighted by colour agreement (Gaussian, σ = 0.12 per channel).
+    pub colour_explained: f64,
+    /// Fraction of object points with a guidance point within τ.
+    pub object_covered: f64,
+}
+
+impl Fit {
+    /// Fraction of the guidance explained (colour-weighted when `colour`) plus half the fraction
+    /// of the object covered: the score reported per object.
+    pub fn score(&self, colour: bool) -> f64 {
+        let fwd = if colour {
+            self.colour_explained
+        } else {
+            self.guidance_explained
+        };
+        fwd + 0.5 * self.object_covered
+    }
+
+    /// What hypotheses are ranked by: the geometric score plus, with colour, the colour score.
+    /// Colour alone is a noisy judge of scale (a lit, tinted print matches itself slightly
+    /// shifted almost as well), geometry alone cannot tell a symmetric shape's twins apart; the
+    /// sum needs both to agree.
+    pub fn rank(&self, colour: bool) -> f64 {
+        self.score(false) + if colour { self.score(true) } else { 0.0 }
+    }
+}
+
+/// The fit of pose `t` within τ = 2% of the guidance diagonal, both ways: guidance → object
+/// (does the object explain the guidance?) and object → guidance (does the pose put object
+/// surface where the guidance is empty?).
+pub fn fit(p: &Problem, t: &Similarity, probe_g: &[usize], probe_o: &[usize]) -> Fit {
     let tau = 0.02 * p.guidance_diagonal();
     let m = t.matrix();
     let inv = m.try_inverse().unwrap_or_else(nalgebra::Matrix4::identity);
-    let mut fwd = 0.0;
+    let (mut geo, mut col) = (0.0, 0.0);
     for &gi in probe_g {
         let q = inv.transform_point(&p.guidance.points[gi]);
         if let Some((oi, d2)) = p.object_tree.nearest(&q) {
             if d2.sqrt() * t.scale < tau {
-                fwd += if colour {
-                    let a = p.guidance.colours[gi];
-                    let b = p.object.colours[oi];
-                    let d2c: f64 = (0..3).map(|k| (a[k] - b[k]).powi(2)).sum();
-                    (-d2c / (2.0 * 0.12 * 0.12)).exp()
-                } else {
-                    1.0
-                };
+                geo += 1.0;
+                let a = p.guidance.colours[gi];
+                let b = p.object.colours[oi];
+                let d2c: f64 = (0..3).map(|k| (a[k] - b[k]).powi(2)).sum();
+                col += (-d2c / (2.0 * 0.12 * 0.12)).exp();
             }
         }
     }
@@ -205,11 +228,128 @@ pub fn score(
             }
         }
     }
-    fwd / probe_g.len().max(1) as f64 + 0.5 * back / probe_o.len().max(1) as f64
+    let ng = probe_g.len().max(1) as f64;
+    Fit {
+        guidance_explained: geo / ng,
+        colour_explained: col / ng,
+        object_covered: back / probe_o.len().max(1) as f64,
+    }
 }
 
-/// Refine every hypothesis with a short ICP, score it, return the best (pose, score) and how many
-/// hypotheses were tried.
+/// How well a pose explains the guidance: the fraction of guidance points with an object point
+/// within `tau` (colour-weighted when `colour`), plus half the fraction of object points with a
+/// guidance point within `tau` (penalises poses that push the object where the guidance is empty).
+pub fn score(
+    p: &Problem,
+    t: &Similarity,
+    colour: bool,
+    probe_g: &[usize],
+    probe_o: &[usize],
+) -> f64 {
+    fit(p, t, probe_g, probe_o).score(colour)
+}
+
+/// Every `len / n`-th index: a deterministic probe subset of about `n` of `len` points.
+pub fn probes(len: usize, n: usize) -> Vec<usize> {
+    (0..len).step_by((len / n.max(1)).max(1)).collect()
+}
+
+/// `t` preceded by the rotation `spin` about the object-frame point `c`: the object turned in
+/// place, its centre staying where `t` put it.
+pub fn spun(t: &Similarity, spin: &UnitQuaternion<f64>, c: &P3) -> Similarity {
+    let rotation = t.rotation * spin;
+    let translation = t.translation + t.scale * (t.rotation * (c.coords - spin * c.coords));
+    Similarity {
+        rotation,
+        translation,
+        ..*t
+    }
+}
+
+/// Turns of the object about its own centre tried around the best hypotheses: every 30° about
+/// each of its OBB axes (the turns a spheroid, a cylinder or a box cannot show by shape), plus
+/// `random` rotations spread over SO(3) (for shapes, like a ball, that show no axis at all).
+pub fn spins(obb: &Obb, random: usize, seed: u64) -> Vec<UnitQuaternion<f64>> {
+    let mut out = Vec::new();
+    for k in 0..3 {
+        let axis = nalgebra::Unit::new_normalize(obb.axes.column(k).into_owned());
+        for step in 1..12 {
+            out.push(UnitQuaternion::from_axis_angle(
+                &axis,
+                step as f64 * std::f64::consts::PI / 6.0,
+            ));
+        }
+    }
+    let mut rng = Rng::new(seed ^ 0x5B1A);
+    out.extend((0..random).map(|_| rng.rotation()));
+    out
+}
+
+/// `t` shifted so the object sits on the guidance: `iterations` translation-only ICP steps
+/// (guidance probe → nearest object sample, the worst 20% of pairs dropped, mean residual). A
+/// turned pose keeps its centre where the untouched pose had it, which for a shape that is not
+/// centred on its own middle (a fruit's flat spot, a pen's clip) is off by a few per cent.
+pub fn recentred(p: &Problem, t: &Similarity, probe_g: &[usize], iterations: usize) -> Similarity {
+    let mut t = *t;
+    let mut res: Vec<(f64, V3)> = Vec::with_capacity(probe_g.len());
+    for _ in 0..iterations {
+        let m = t.matrix();
+        let Some(inv) = m.try_inverse() else { break };
+        res.clear();
+        for &gi in probe_g {
+            let g = p.guidance.points[gi];
+            if let Some((oi, _)) = p.object_tree.nearest(&inv.transform_point(&g)) {
+                let d = g - m.transform_point(&p.object.points[oi]);
+                res.push((d.norm_squared(), d));
+            }
+        }
+        if res.is_empty() {
+            break;
+        }
+        res.sort_by(|a, b| a.0.total_cmp(&b.0));
+        let k = (res.len() * 4 / 5).max(1);
+        t.translation += res[..k].iter().fold(V3::zeros(), |a, r| a + r.1) / k as f64;
+    }
+    t
+}
+
+/// Pattern search on the rank over turns of the object about its centre: ±15°, ±7.5°, ±3.75°
+/// about the object's x, y and z axes, each step size until no turn improves the rank (at most
+/// three rounds). Returns the best pose found and its rank.
+pub fn climb_rotation(
+    p: &Problem,
+    t: Similarity,
+    rank: f64,
+    probe_g: &[usize],
+    probe_o: &[usize],
+    colour: bool,
+) -> (Similarity, f64) {
+    let c = p.object_obb.center;
+    let mut best = (t, rank);
+    for deg in [15.0f64, 7.5, 3.75] {
+        for _ in 0..3 {
+            let base = best;
+            for axis in [V3::x_axis(), V3::y_axis(), V3::z_axis()] {
+                for sign in [-1.0, 1.0] {
+                    let turn = UnitQuaternion::from_axis_angle(&axis, sign * deg.to_radians());
+                    let cand = spun(&base.0, &turn, &c);
+                    let r = fit(p, &cand, probe_g, probe_o).rank(colour);
+                    if r > best.1 {
+                        best = (cand, r);
+                    }
+                }
+            }
+            if best.1 <= base.1 {
+                break;
+            }
+        }
+    }
+    best
+}
+
+/// Refine every hypothesis with a short ICP and rank it ([`Fit::rank`]); then turn the best
+/// few in place ([`spins`]), rank the turned poses as they are, refine the best of those too,
+/// and return the best (pose, rank) of all.
 pub fn best_hypothesis(
     p: &Problem,
     hyps: &[Similarity],
@@ -219,27 +359,103 @@ pub fn best_hypothesis(
 ) -> Option<(Similarity, f64)> {
     use rayon::prelude::*;
     let g_short = p.guidance.subsample(500);
-    let probe_g: Vec<usize> = (0..p.guidance.len())
-        .step_by((p.guidance.len() / 700).max(1))
-        .collect();
-    let probe_o: Vec<usize> = (0..p.object.len())
-        .step_by((p.object.len() / 700).max(1))
-        .collect();
+    let probe_g = probes(p.guidance.len(), 700);
+    let probe_o = probes(p.object.len(), 700);
     let short = IcpOptions {
         iterations: 20,
         ..*icp
     };
-    let results: Vec<(Similarity, f64)> = hyps
+    let refine_and_rank = |h: &Similarity| {
+        let (t, _) = trimmed_icp(&p.object.points, matcher, &g_short, *h, &short);
+        (t, fit(p, &t, &probe_g, &probe_o).rank(colour))
+    };
+    let mut results: Vec<(Similarity, f64)> = hyps.par_iter().map(refine_and_rank).collect();
+    // The best few distinct poses, turned in place and ranked on coarse probes.
+    let mut order: Vec<usize> = (0..results.len()).collect();
+    order.sort_by(|&a, &b| results[b].1.total_cmp(&results[a].1).then(a.cmp(&b)));
+    let mut bases: Vec<Similarity> = Vec::new();
+    for &i in &order {
+        let t = results[i].0;
+        if bases.len() < 2 && bases.iter().all(|b| b.rotation.angle_to(&t.rotation) > 0.2) {
+            bases.push(t);
+        }
+    }
+    // Axis turns around both bases; the SO(3) samples around the best one only (about its
+    // centre they already cover every orientation).
+    let axis_turns = spins(&p.object_obb, 0, p.seed);
+    let random_turns =
+        spins(&p.object_obb, if colour { 500 } else { 240 }, p.seed)[axis_turns.len()..].to_vec();
+    let coarse_g = probes(p.guidance.len(), 200);
+    let coarse_o = probes(p.object.len(), 200);
+    let c = p.object_obb.center;
+    let mut candidates: Vec<Similarity> = bases
+        .iter()
+        .flat_map(|b| axis_turns.iter().map(move |s| spun(b, s, &c)))
+        .collect();
+    if let Some(b) = bases.first() {
+        candidates.extend(random_turns.iter().map(|s| spun(b, s, &c)));
+    }
+    let mut turned: Vec<(Similarity, f64)> = candidates
         .par_iter()
-        .map(|h| {
-            let (t, _) = trimmed_icp(&p.object.points, matcher, &g_short, *h, &short);
-            let s = score(p, &t, colour, &probe_g, &probe_o);
-            (t, s)
+        .map(|t| {
+            let t = recentred(p, t, &coarse_g, 2);
+            (t, fit(p, &t, &coarse_g, &coarse_o).rank(colour))
         })
         .collect();
+    turned.sort_by(|a, b| b.1.total_cmp(&a.1));
+    // The best eight that differ by more than 20° (neighbours of one good pose rank alike).
+    let mut distinct: Vec<(Similarity, f64)> = Vec::new();
+    for &(t, r) in &turned {
+        if distinct.len() == 8 {
+            break;
+        }
+        if distinct
+            .iter()
+            .all(|d| d.0.rotation.angle_to(&t.rotation) > 20f64.to_radians())
+        {
+            distinct.push((t, r));
+        }
+    }
+    let more: Vec<(Similarity, f64)> = distinct
+        .par_iter()
+        .map(|(t, _)| refine_and_rank(t))
+        .collect();
+    results.extend(more);
     results
         .into_iter()
         .enumerate()
         .max_by(|a, b| a.1 .1.total_cmp(&b.1 .1).then(b.0.cmp(&a.0)))
         .map(|(_, r)| r)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn turning_in_place_keeps_the_centre_and_composes_the_rotation() {
+        let t = Similarity {
+            scale: 1.7,
+            rotation: UnitQuaternion::from_euler_angles(-0.4, 0.9, 0.2),
+            translation: V3::new(3.0, 0.0, -1.0),
+        };
+        let c = P3::new(0.1, -0.2, 0.3);
+        let spin = UnitQuaternion::from_euler_angles(0.0, 0.0, std::f64::consts::FRAC_PI_2);
+        let s = spun(&t, &spin, &c);
+        let (m0, m1) = (t.matrix(), s.matrix());
+        assert!((m0.transform_point(&c) - m1.transform_point(&c)).norm() < 1e-12);
+        // A point turned by the spin about c first, then placed by t.
+        let q = P3::new(1.0, 0.5, -0.5);
+        let turned = c + spin * (q - c);
+        assert!((m1.transform_point(&q) - m0.transform_point(&turned)).norm() < 1e-12);
+        // 33 axis turns (11 per OBB axis) plus the random ones, none the identity.
+        let obb = crate::compose::obb::Obb {
+            center: P3::origin(),
+            axes: nalgebra::Matrix3::identity(),
+            extents: V3::new(3.0, 2.0, 1.0),
+        };
+        let turns = spins(&obb, 5, 1);
+        assert_eq!(turns.len(), 38);
+        assert!(turns.iter().all(|r| r.angle() > 0.1));
+    }
 }

@@ -26,6 +26,7 @@ pub mod icp;
 pub mod kdtree;
 pub mod obb;
 pub mod refine;
+pub mod scale;
 pub mod sdf;
 pub mod synth;
 
@@ -327,12 +328,22 @@ fn register(
     };
     let g_icp = guidance.subsample(1500);
     let (t, rms) = trimmed_icp(&object.points, &matcher, &g_icp, init, &icp);
-    let probe_g: Vec<usize> = (0..guidance.len())
-        .step_by((guidance.len() / 700).max(1))
-        .collect();
-    let probe_o: Vec<usize> = (0..object.len())
-        .step_by((object.len() / 700).max(1))
-        .collect();
+    let probe_g = global::probes(guidance.len(), 700);
+    let probe_o = global::probes(object.len(), 700);
+    let (t, rms) = if matches!(method, Method::IcpOnly | Method::RansacIcp) {
+        (t, rms)
+    } else {
+        let (t, _) = scale::search(
+            &p, &matcher, &g_icp, t, &icp, use_colour, &probe_g, &probe_o,
+        );
+        // Free ICP again, its scale now held within ±1.5% of the chosen one.
+        let near = IcpOptions {
+            scale_lo: t.scale / 1.015,
+            scale_hi: t.scale * 1.015,
+            ..icp
+        };
+        trimmed_icp(&object.points, &matcher, &g_icp, t, &near)
+    };
     let score = global::score(&p, &t, use_colour, &probe_g, &probe_o);
     (
         t,
