@@ -18,7 +18,8 @@
 //! time they are decomposed.
 //!
 //! Applied to objects without neighbours only (see `decompose_scene`): on the `ball_bowl`
-//! scene, a rebalanced bowl let MuJoCo roll the ball 0.6 mm while Rapier held it.
+//! scene, a rebalanced bowl let MuJoCo roll the ball 0.6 mm while Rapier held it (merges
+//! only), and with the border moves Rapier rolled it 7 mm.
 //!
 //! Merged hulls are cached by the pair of patch ids (a patch gets a new id when it changes),
 //! so a round builds only the merges next to the three patches it changed.
