@@ -282,13 +282,10 @@ fn export_folder_validates_from_its_settled_poses() {
 }
 
 /// Issue #4's analytic check: after export, the ball lies at the bottom of the bowl in MuJoCo.
-/// From the bowl fixture's construction (fixtures/ball_bowl/README.md): the ball's centre is on
-/// the bowl's axis, its resting quad face on the flat inner floor, so its centre is
-/// 36.684 mm above the bowl's foot (37.434 mm in the composed pose minus the 0.75 mm gap).
-/// The bowl is symmetric about its axis, so its centre of mass lies on that axis.
-#[test]
-fn ball_rests_at_the_bottom_of_the_bowl_in_mujoco_after_2_s() {
-    let o = export_validated(&root().join("fixtures/ball_bowl"));
+/// Export `fixture`, check its verdict passes, run it 2 s in MuJoCo, assert MuJoCo finds no
+/// initial contact between objects deeper than 0.1 mm, and return where each body ends.
+fn rest_in_mujoco_after_2_s(fixture: &str) -> serde_json::Value {
+    let o = export_validated(&root().join("fixtures").join(fixture));
     assert_eq!(o.code, 0, "{}", o.report["validation"]["checks"]);
     let dir = o.out.path().join("out");
     let mj = python_json(
@@ -297,23 +294,37 @@ fn ball_rests_at_the_bottom_of_the_bowl_in_mujoco_after_2_s() {
     );
     assert!(
         mj["initial_penetration"].as_f64().unwrap() <= 0.1 * MM,
-        "{}",
+        "{fixture}: {}",
         mj["initial_penetration"]
     );
-    let p = |n: &str| -> Vec<f64> {
-        mj["final_pos"][n]
-            .as_array()
-            .unwrap()
-            .iter()
-            .map(|x| x.as_f64().unwrap())
-            .collect()
-    };
-    let (bowl, ball) = (p("object_a"), p("object_b"));
-    let expected = [bowl[0], bowl[1], 0.036684];
+    mj["final_pos"].clone()
+}
+
+/// Body `name`'s final position, and its distance from `expected`.
+fn final_pos(pos: &serde_json::Value, name: &str, expected: [f64; 3]) -> (Vec<f64>, f64) {
+    let p: Vec<f64> = pos[name]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|x| x.as_f64().unwrap())
+        .collect();
     let err = (0..3)
-        .map(|k| (ball[k] - expected[k]).powi(2))
+        .map(|k| (p[k] - expected[k]).powi(2))
         .sum::<f64>()
         .sqrt();
+    (p, err)
+}
+
+/// From the bowl fixture's construction (fixtures/ball_bowl/README.md): the ball's centre is on
+/// the bowl's axis, its resting quad face on the flat inner floor, so its centre is
+/// 36.684 mm above the bowl's foot (37.434 mm in the composed pose minus the 0.75 mm gap).
+/// The bowl is symmetric about its axis, so its centre of mass lies on that axis.
+#[test]
+fn ball_rests_at_the_bottom_of_the_bowl_in_mujoco_after_2_s() {
+    let pos = rest_in_mujoco_after_2_s("ball_bowl");
+    let (bowl, _) = final_pos(&pos, "object_a", [0.0; 3]);
+    let expected = [bowl[0], bowl[1], 0.036684];
+    let (ball, err) = final_pos(&pos, "object_b", expected);
     assert!(
         err <= MM,
         "ball at {ball:?}, expected {expected:?}: {:.3} mm off",
@@ -323,33 +334,13 @@ fn ball_rests_at_the_bottom_of_the_bowl_in_mujoco_after_2_s() {
 
 /// From the shelf fixture's construction (fixtures/shelf_item/README.md): the box stands on the
 /// middle board, whose top face is at z = 300 mm, at (x, y) = (30, 10) mm; its centre rests
-/// 50 mm above the board (350.75 mm in the composed pose minus the 0.75 mm gap). MuJoCo must
-/// find no initial contact deeper than 0.1 mm and, after 2 s, the box still in the shelf.
+/// 50 mm above the board (350.75 mm in the composed pose minus the 0.75 mm gap). After 2 s in
+/// MuJoCo the box must still be there, in the shelf.
 #[test]
 fn box_stays_on_the_middle_shelf_board_in_mujoco_after_2_s() {
-    let o = export_validated(&root().join("fixtures/shelf_item"));
-    assert_eq!(o.code, 0, "{}", o.report["validation"]["checks"]);
-    let dir = o.out.path().join("out");
-    let mj = python_json(
-        "check_mujoco.py",
-        &[dir.to_str().unwrap(), "--seconds", "2"],
-    );
-    assert!(
-        mj["initial_penetration"].as_f64().unwrap() <= 0.1 * MM,
-        "{}",
-        mj["initial_penetration"]
-    );
-    let bx: Vec<f64> = mj["final_pos"]["box"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .map(|x| x.as_f64().unwrap())
-        .collect();
+    let pos = rest_in_mujoco_after_2_s("shelf_item");
     let expected = [0.030, 0.010, 0.350];
-    let err = (0..3)
-        .map(|k| (bx[k] - expected[k]).powi(2))
-        .sum::<f64>()
-        .sqrt();
+    let (bx, err) = final_pos(&pos, "box", expected);
     assert!(
         err <= MM,
         "box at {bx:?}, expected {expected:?}: {:.3} mm off",
