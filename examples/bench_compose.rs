@@ -149,6 +149,7 @@ fn main() {
                 row.secs += secs;
                 row.pairs += s.inputs.len();
                 let mut placed = Vec::new();
+                let mut all_ok = true;
                 for (inp, truth) in s.inputs.iter().zip(&s.truth) {
                     let est = comp.get(&inp.name).unwrap().transform;
                     let (r, t, sc) = synth::errors(&est, truth);
@@ -159,6 +160,7 @@ fn main() {
                     row.scale.push(100.0 * sc);
                     row.n += 1;
                     row.ok += ok as usize;
+                    all_ok &= ok;
                     if verbose && !ok {
                         eprintln!(
                             "  FAIL {:<12} {:<28} seed {seed} {:<10} rot {r:7.2}° trans {:6.3}% scale {:6.3}%",
@@ -186,6 +188,19 @@ fn main() {
                         rv = rv.max(pm.r_volume);
                         pen = pen.max(pm.max_penetration_depth);
                     }
+                }
+                if verbose && rv > 1e-4 {
+                    eprintln!(
+                        "  R_VOLUME {:<9} {:<28} seed {seed} R_volume {rv:.1e} pen {:.3} mm ({})",
+                        m.label(),
+                        case.name,
+                        1000.0 * pen / s.frame.scale,
+                        if all_ok {
+                            "registration succeeded"
+                        } else {
+                            "a registration failed"
+                        }
+                    );
                 }
                 row.rvol.push(rv);
                 // guidance units → scene metres → mm

@@ -31,7 +31,7 @@ pub mod sdf;
 pub mod synth;
 
 use crate::error::{Error, Result};
-use crate::mesh::{Mesh, VisualMesh};
+use crate::mesh::{Mesh, VisualMesh, P3};
 use crate::pose::Similarity;
 use cloud::Cloud;
 use global::{best_hypothesis, FpfhRansac, GlobalRegistration, ObbHypotheses, Problem};
@@ -424,19 +424,40 @@ pub fn compose(inputs: &[ObjectInput], o: &ComposeOptions) -> Result<Composition
                 } else {
                     icp::Matcher::Geometry(&sub_tree)
                 };
-                let r = refine(
-                    &sub.points,
-                    &Target::Guidance {
-                        points: &g.points,
-                        colours: &g.colours,
-                        matcher: &matcher,
-                        keep: 0.8,
-                    },
-                    t,
-                    f,
-                    unit,
-                    &o.refine,
-                );
+                let target = Target::Guidance {
+                    points: &g.points,
+                    colours: &g.colours,
+                    matcher: &matcher,
+                    keep: 0.8,
+                };
+                let mut r = refine(&sub.points, &target, t, f, unit, &o.refine);
+                // Dense check: 700 samples miss thin parts between them (a shoe's edge stayed
+                // 1.5 mm inside the tray). The object's vertices within the clearance band join
+                // the samples for a second pass that removes what is left while moving the
+                // object as little as possible from the refined pose (as `--fix-penetration`
+                // does); pulling towards the guidance again let a round fruit drift 70°.
+                let m = r.transform.matrix();
+                let band = o.refine.epsilon * unit;
+                let near: Vec<(P3, f64)> = inp
+                    .visual
+                    .geometry()
+                    .vertices
+                    .into_iter()
+                    .filter_map(|v| {
+                        let phi = f.eval(&m.transform_point(&v)).0;
+                        (phi < band).then_some((v, phi))
+                    })
+                    .collect();
+                let deepest = near.iter().map(|x| -x.1).fold(0.0, f64::max);
+                if deepest > o.refine.tolerance * unit {
+                    let mut pts = sub.points.clone();
+                    pts.extend(near.iter().map(|x| x.0));
+                    let r2 = refine(&pts, &Target::InitialPose, r.transform, f, unit, &o.refine);
+                    r = Refined {
+                        penetration_before: r.penetration_before.max(deepest),
+                        ..r2
+                    };
+                }
                 t = r.transform;
                 method.push_str("+collision_refine");
                 refinement = Some(RefineReport::from(&r));
