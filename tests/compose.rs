@@ -56,28 +56,14 @@ fn compose_and_check(src: &Path, seed: u64, tmp: &Path) {
         "{}",
         reg["penetration_check"]
     );
-    let diag = s
-        .inputs
-        .iter()
-        .zip(&s.truth)
-        .filter_map(|(i, t)| i.visual.geometry().transformed(&t.matrix()).aabb())
-        .reduce(|a, b| a.union(&b))
-        .unwrap()
-        .diagonal();
-    for (inp, t) in s.inputs.iter().zip(&s.truth) {
-        let entry = &reg["transforms"][&inp.name];
+    assert_registered(&s, |name| {
+        let entry = &reg["transforms"][name];
         let est = interact3d::scene::sample::parse_transform(entry).unwrap();
         // The parts agree with the matrix.
         assert!((entry["scale"].as_f64().unwrap() - est.scale).abs() < 1e-9 * est.scale);
-        let (rot, trans, scale) = synth::errors(&est, t);
-        let rot_ok = rot < 5.0 || synth::appearance_equivalent(&inp.visual, &est, t);
-        assert!(
-            rot_ok && trans < 0.02 * diag && scale < 0.03,
-            "{}: rot {rot:.2}° trans {:.3}% scale {:.3}%",
-            inp.name,
-            100.0 * trans / diag,
-            100.0 * scale
-        );
+        est
+    });
+    for inp in &s.inputs {
         assert!(out.join(format!("{}.glb", inp.name)).is_file());
     }
     // scene.json is a manifest with the same poses.
@@ -93,6 +79,32 @@ fn compose_and_check(src: &Path, seed: u64, tmp: &Path) {
     let code = common::export(&out, &exp, &["--points", "20000"]);
     assert!(code == 0 || code == 1);
     assert!(exp.join("report.json").is_file());
+}
+
+/// Every object's estimated pose (`est(name)`) within the benchmark's success thresholds of
+/// the truth: rotation < 5° (or the same appearance), translation < 2 % of the scene
+/// diagonal, scale < 3 %.
+fn assert_registered(s: &synth::Synthetic, est: impl Fn(&str) -> Similarity) {
+    let diag = s
+        .inputs
+        .iter()
+        .zip(&s.truth)
+        .filter_map(|(i, t)| i.visual.geometry().transformed(&t.matrix()).aabb())
+        .reduce(|a, b| a.union(&b))
+        .unwrap()
+        .diagonal();
+    for (inp, t) in s.inputs.iter().zip(&s.truth) {
+        let est = est(&inp.name);
+        let (rot, trans, scale) = synth::errors(&est, t);
+        let rot_ok = rot < 5.0 || synth::appearance_equivalent(&inp.visual, &est, t);
+        assert!(
+            rot_ok && trans < 0.02 * diag && scale < 0.03,
+            "{}: rot {rot:.2}° trans {:.3}% scale {:.3}%",
+            inp.name,
+            100.0 * trans / diag,
+            100.0 * scale
+        );
+    }
 }
 
 fn dir_listing(d: &Path) -> Vec<(String, u64)> {
@@ -150,26 +162,7 @@ fn composes_three_shoes_on_a_tray_without_overlap() {
         ..Default::default()
     };
     let comp = compose(&s.inputs, &o).unwrap();
-    let diag = s
-        .inputs
-        .iter()
-        .zip(&s.truth)
-        .filter_map(|(i, t)| i.visual.geometry().transformed(&t.matrix()).aabb())
-        .reduce(|a, b| a.union(&b))
-        .unwrap()
-        .diagonal();
-    for (inp, t) in s.inputs.iter().zip(&s.truth) {
-        let est = comp.get(&inp.name).unwrap().transform;
-        let (rot, trans, scale) = synth::errors(&est, t);
-        let rot_ok = rot < 5.0 || synth::appearance_equivalent(&inp.visual, &est, t);
-        assert!(
-            rot_ok && trans < 0.02 * diag && scale < 0.03,
-            "{}: rot {rot:.2}° trans {:.3}% scale {:.3}%",
-            inp.name,
-            100.0 * trans / diag,
-            100.0 * scale
-        );
-    }
+    assert_registered(&s, |name| comp.get(name).unwrap().transform);
     let placed: Vec<_> = s
         .inputs
         .iter()
