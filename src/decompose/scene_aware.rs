@@ -80,8 +80,8 @@ pub struct ObjectReport {
     pub convex_shortcut: bool,
     /// Patch splits made to meet the tolerance.
     pub quality_splits: usize,
-    /// Rounds of the rebalancing (merge two adjacent patches, split the worst) that lowered the
-    /// worst deviation once the budget was spent.
+    /// Moves of the rebalancing (see `rebalance.rs`) that lowered the worst deviation once the
+    /// budget was spent.
     #[serde(default)]
     pub rebalance_rounds: usize,
     /// Patch splits made because a hull met a neighbour.
