@@ -128,14 +128,7 @@ fn main() {
     for case in &cases {
         for seed in seed_offset..seed_offset + seeds {
             let s = synth::make(&case.objects, 1000 + seed, &gen);
-            let scene_bb = s
-                .inputs
-                .iter()
-                .zip(&s.truth)
-                .filter_map(|(i, t)| i.visual.geometry().transformed(&t.matrix()).aabb())
-                .reduce(|a, b| a.union(&b))
-                .unwrap();
-            let diag = scene_bb.diagonal();
+            let diag = s.diagonal();
             for (mi, &m) in methods.iter().enumerate() {
                 let o = ComposeOptions {
                     method: m,
@@ -150,11 +143,10 @@ fn main() {
                 row.pairs += s.inputs.len();
                 let mut placed = Vec::new();
                 let mut all_ok = true;
-                for (inp, truth) in s.inputs.iter().zip(&s.truth) {
+                for (k, inp) in s.inputs.iter().enumerate() {
                     let est = comp.get(&inp.name).unwrap().transform;
-                    let (r, t, sc) = synth::errors(&est, truth);
-                    let rot_ok = r < 5.0 || synth::appearance_equivalent(&inp.visual, &est, truth);
-                    let ok = rot_ok && t < 0.02 * diag && sc < 0.03;
+                    let j = s.judge(k, &est, diag);
+                    let (r, t, sc, ok) = (j.rot_deg, j.trans, j.scale, j.success);
                     row.rot.push(r);
                     row.trans.push(100.0 * t / diag);
                     row.scale.push(100.0 * sc);

@@ -65,6 +65,44 @@ pub struct Synthetic {
     pub removed: Vec<f64>,
 }
 
+/// A composed pose against its truth, by the benchmark's success thresholds.
+#[derive(Clone, Copy, Debug)]
+pub struct Judged {
+    pub success: bool,
+    /// Rotation error (degrees), translation error (guidance units), relative scale error.
+    pub rot_deg: f64,
+    pub trans: f64,
+    pub scale: f64,
+}
+
+impl Synthetic {
+    /// Diagonal of the true composed scene's bounding box, in guidance units: the unit of the
+    /// translation threshold in [`Synthetic::judge`].
+    pub fn diagonal(&self) -> f64 {
+        self.inputs
+            .iter()
+            .zip(&self.truth)
+            .filter_map(|(i, t)| i.visual.geometry().transformed(&t.matrix()).aabb())
+            .reduce(|a, b| a.union(&b))
+            .map_or(0.0, |b| b.diagonal())
+    }
+
+    /// Input `k` composed at `est`: a success when the rotation error is below 5° (or the pose
+    /// looks the same, see [`appearance_equivalent`]), the translation error below 2 % of
+    /// `diag` (from [`Synthetic::diagonal`]) and the scale error below 3 %.
+    pub fn judge(&self, k: usize, est: &Similarity, diag: f64) -> Judged {
+        let truth = &self.truth[k];
+        let (rot_deg, trans, scale) = errors(est, truth);
+        let rot_ok = rot_deg < 5.0 || appearance_equivalent(&self.inputs[k].visual, est, truth);
+        Judged {
+            success: rot_ok && trans < 0.02 * diag && scale < 0.03,
+            rot_deg,
+            trans,
+            scale,
+        }
+    }
+}
+
 /// Read a ground-truth sample folder (objects + their poses in metadata.json).
 pub fn load_truth(dir: &Path) -> Result<Vec<TruthObject>> {
     let scene = crate::scene::sample::load(dir, &Limits::default())?;
