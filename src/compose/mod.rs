@@ -408,6 +408,9 @@ pub fn compose(inputs: &[ObjectInput], o: &ComposeOptions) -> Result<Composition
         let (mut t, mut method, scale0, score, rms, n_hyp, colour_used) =
             register(&object, &guidance, o.method, seed);
         let mut refinement = None;
+        // The object's welded mesh, built once for the dense check and the anchor field.
+        let geometry = std::cell::OnceCell::new();
+        let geometry = || geometry.get_or_init(|| inp.visual.geometry());
         if rank > 0 && o.method.refines() {
             if let Some(f) = &field {
                 let g = guidance.subsample(600);
@@ -438,12 +441,10 @@ pub fn compose(inputs: &[ObjectInput], o: &ComposeOptions) -> Result<Composition
                 // does); pulling towards the guidance again let a round fruit drift 70°.
                 let m = r.transform.matrix();
                 let band = o.refine.epsilon * unit;
-                let near: Vec<(P3, f64)> = inp
-                    .visual
-                    .geometry()
+                let near: Vec<(P3, f64)> = geometry()
                     .vertices
-                    .into_iter()
-                    .filter_map(|v| {
+                    .iter()
+                    .filter_map(|&v| {
                         let phi = f.eval(&m.transform_point(&v)).0;
                         (phi < band).then_some((v, phi))
                     })
@@ -464,7 +465,7 @@ pub fn compose(inputs: &[ObjectInput], o: &ComposeOptions) -> Result<Composition
             }
         }
         if o.method.refines() && rank + 1 < order.len() {
-            let placed: Mesh = inp.visual.geometry().transformed(&t.matrix());
+            let placed: Mesh = geometry().transformed(&t.matrix());
             let fld = field.get_or_insert_with(|| AnchorField::new(&[], 32));
             fld.push(&placed, 32);
         }
