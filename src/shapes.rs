@@ -372,7 +372,7 @@ pub fn rounded_rect(hx: f64, hy: f64, r: f64, segments: usize, z: f64) -> Vec<P3
 /// vertices are shared (the boards' corners lie inside the panels' faces), so the mesh is
 /// closed and its volume is the sum of the boxes'.
 pub fn shelf(width: f64, depth: f64, height: f64, board: f64, levels: &[f64]) -> Mesh {
-    let inset = 0.005;
+    let inset = SHELF_INSET;
     assert!(width > 2.0 * board && depth > 2.0 * inset);
     let mut m = Mesh::new(Vec::new(), Vec::new());
     let mut put = |ext: V3, c: V3| {
@@ -395,9 +395,13 @@ pub fn shelf(width: f64, depth: f64, height: f64, board: f64, levels: &[f64]) ->
     m
 }
 
+/// How far [`shelf`]'s boards are set back from the panels' front and back edges.
+const SHELF_INSET: f64 = 0.005;
+
 /// Volume of [`shelf`].
 pub fn shelf_volume(width: f64, depth: f64, height: f64, board: f64, levels: usize) -> f64 {
-    2.0 * board * depth * height + levels as f64 * (width - 2.0 * board) * (depth - 0.01) * board
+    let board_depth = depth - 2.0 * SHELF_INSET;
+    2.0 * board * depth * height + levels as f64 * (width - 2.0 * board) * board_depth * board
 }
 
 /// A flat tray standing on z = 0, centred on the z axis: outer footprint `extents[0] × extents[1]`

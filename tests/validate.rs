@@ -300,19 +300,23 @@ fn rest_in_mujoco_after_2_s(fixture: &str) -> serde_json::Value {
     mj["final_pos"].clone()
 }
 
-/// Body `name`'s final position, and its distance from `expected`.
-fn final_pos(pos: &serde_json::Value, name: &str, expected: [f64; 3]) -> (Vec<f64>, f64) {
-    let p: Vec<f64> = pos[name]
-        .as_array()
-        .unwrap()
-        .iter()
-        .map(|x| x.as_f64().unwrap())
-        .collect();
+/// Body `name`'s final position.
+fn body_pos(pos: &serde_json::Value, name: &str) -> [f64; 3] {
+    let p = &pos[name];
+    [0, 1, 2].map(|k| p[k].as_f64().unwrap())
+}
+
+/// `what` ended within 1 mm of `expected`.
+fn assert_within_1_mm(what: &str, got: [f64; 3], expected: [f64; 3]) {
     let err = (0..3)
-        .map(|k| (p[k] - expected[k]).powi(2))
+        .map(|k| (got[k] - expected[k]).powi(2))
         .sum::<f64>()
         .sqrt();
-    (p, err)
+    assert!(
+        err <= MM,
+        "{what} at {got:?}, expected {expected:?}: {:.3} mm off",
+        err / MM
+    );
 }
 
 /// From the bowl fixture's construction (fixtures/ball_bowl/README.md): the ball's centre is on
@@ -322,14 +326,9 @@ fn final_pos(pos: &serde_json::Value, name: &str, expected: [f64; 3]) -> (Vec<f6
 #[test]
 fn ball_rests_at_the_bottom_of_the_bowl_in_mujoco_after_2_s() {
     let pos = rest_in_mujoco_after_2_s("ball_bowl");
-    let (bowl, _) = final_pos(&pos, "object_a", [0.0; 3]);
+    let bowl = body_pos(&pos, "object_a");
     let expected = [bowl[0], bowl[1], 0.036684];
-    let (ball, err) = final_pos(&pos, "object_b", expected);
-    assert!(
-        err <= MM,
-        "ball at {ball:?}, expected {expected:?}: {:.3} mm off",
-        err / MM
-    );
+    assert_within_1_mm("ball", body_pos(&pos, "object_b"), expected);
 }
 
 /// From the shelf fixture's construction (fixtures/shelf_item/README.md): the box stands on the
@@ -339,11 +338,5 @@ fn ball_rests_at_the_bottom_of_the_bowl_in_mujoco_after_2_s() {
 #[test]
 fn box_stays_on_the_middle_shelf_board_in_mujoco_after_2_s() {
     let pos = rest_in_mujoco_after_2_s("shelf_item");
-    let expected = [0.030, 0.010, 0.350];
-    let (bx, err) = final_pos(&pos, "box", expected);
-    assert!(
-        err <= MM,
-        "box at {bx:?}, expected {expected:?}: {:.3} mm off",
-        err / MM
-    );
+    assert_within_1_mm("box", body_pos(&pos, "box"), [0.030, 0.010, 0.350]);
 }
