@@ -69,7 +69,7 @@ use std::sync::Mutex;
 /// Engine name, recorded in reports and in the cache key.
 pub const NAME: &str = "scene_aware";
 /// Bumped whenever the output for the same input changes (invalidates the cache).
-pub const VERSION: u32 = 3;
+pub const VERSION: u32 = 4;
 
 /// What happened to one object.
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
@@ -575,8 +575,21 @@ fn split(
 
 /// Decompose one object alone. `budget`: most hulls the quality loop may use; `rounds`: most
 /// rebalancing rounds once it is spent (see [`rebalance`]).
+#[cfg(test)]
 fn decompose_alone(mesh: &Mesh, opts: &DecomposeOptions, budget: usize, rounds: usize) -> Obj {
-    let surf = Surface::new(mesh);
+    decompose_object(Surface::new(mesh), opts, budget, rounds, &[])
+}
+
+/// [`decompose_alone`] on a prepared surface. `near[t]`: a lower bound on how far triangle
+/// `t` is from the ground and every neighbour's collision geometry (empty: nothing is
+/// pinned); the rebalancing leaves alone the patches within reach of them.
+fn decompose_object(
+    surf: Option<Surface>,
+    opts: &DecomposeOptions,
+    budget: usize,
+    rounds: usize,
+    near: &[f64],
+) -> Obj {
     let Some(s) = surf.as_ref() else {
         return Obj {
             surf: None,
@@ -624,7 +637,8 @@ fn decompose_alone(mesh: &Mesh, opts: &DecomposeOptions, budget: usize, rounds: 
         }
     }
     if parts.len() >= budget {
-        report.rebalance_rounds = rebalance::rebalance(s, &feat, &p, opts, &mut parts, rounds);
+        report.rebalance_rounds =
+            rebalance::rebalance(s, &feat, &p, opts, &mut parts, rounds, near);
     }
     Obj {
         parts,
@@ -633,6 +647,48 @@ fn decompose_alone(mesh: &Mesh, opts: &DecomposeOptions, budget: usize, rounds: 
         params: Some(p),
         report,
     }
+}
+
+/// For each triangle of `s`, a lower bound on its distance to what the object touches: the
+/// ground (the plane `z = ground`: scenes rest on it by now), for down-facing triangles only,
+/// and the neighbours' collision geometry. That is the distance from its centroid, less its
+/// circumradius about the centroid and, for a neighbour, the neighbour's tolerance (its hulls
+/// may bulge that far past its surface). Triangles beyond a quarter of the diagonal from a
+/// neighbour's box skip its query.
+fn contact_distances(
+    s: &Surface,
+    ground: f64,
+    nbs: &[&Surface],
+    opts: &DecomposeOptions,
+) -> Vec<f64> {
+    let far = 0.25 * s.diag;
+    (0..s.mesh.triangles.len())
+        .into_par_iter()
+        .map(|t| {
+            let c = s.tri_centroid[t];
+            let r = s
+                .mesh
+                .triangle(t)
+                .iter()
+                .map(|v| (v - c).norm())
+                .fold(0.0, f64::max);
+            let ground = if s.tri_normal[t].z < -0.5 {
+                c.z - ground - r
+            } else {
+                f64::INFINITY
+            };
+            nbs.iter()
+                .map(|nb| {
+                    let pad = r + opts.tolerance * nb.diag;
+                    let probe = crate::mesh::Aabb { min: c, max: c };
+                    if !nb.aabb.intersects(&probe, far + pad) {
+                        return f64::INFINITY;
+                    }
+                    nb.distance(&c) - pad
+                })
+                .fold(ground, f64::min)
+        })
+        .collect()
 }
 
 /// How deep the vertices of `b` sit inside closed mesh `a` (0 when none does).
@@ -756,21 +812,42 @@ pub fn decompose_scene(
     let has_neighbour: Vec<bool> = (0..n)
         .map(|a| (0..n).any(|b| b != a && near(a, b)))
         .collect();
-    let mut objs: Vec<Obj> = objects
-        .par_iter()
+    let surfs: Vec<Option<Surface>> = objects.par_iter().map(|m| Surface::new(m)).collect();
+    // Per triangle, how far the ground and the neighbours are: the rebalancing leaves the
+    // patches they may touch as the quality loop made them. On `ball_bowl`, rebalancing the
+    // bowl let MuJoCo roll the ball 0.6 mm and turn it 1.02° (Rapier 7 mm with the border
+    // moves); pinning the patches near the ball alone left that as it was, pinning also the
+    // down-facing ones near the ground (the bowl's foot) gave back the motion of no
+    // rebalancing at all (0.32 mm, 0.55°).
+    let ground = boxes
+        .iter()
+        .flatten()
+        .map(|b| b.min.z)
+        .fold(f64::INFINITY, f64::min);
+    let nears: Vec<Vec<f64>> = (0..n)
+        .map(|k| {
+            let nbs: Vec<&Surface> = (0..n)
+                .filter(|&b| b != k && near(k, b))
+                .filter_map(|b| surfs[b].as_ref())
+                .collect();
+            // An object alone is not pinned: how it stands on the ground matters to nobody.
+            match &surfs[k] {
+                Some(s) if !nbs.is_empty() => contact_distances(s, ground, &nbs, opts),
+                _ => Vec::new(),
+            }
+        })
+        .collect();
+    let mut objs: Vec<Obj> = surfs
+        .into_par_iter()
+        .zip(nears.par_iter())
         .enumerate()
-        .map(|(k, m)| {
+        .map(|(k, (surf, near_k))| {
             let budget = if has_neighbour[k] {
                 opts.max_hulls - opts.max_hulls / 8
             } else {
                 opts.max_hulls
             };
-            // Rebalancing only for objects alone: with it, the bowl of `ball_bowl` got a floor
-            // on which the ball rolled (MuJoCo 0.6 mm with merges only, Rapier 7 mm with the
-            // border moves); objects with neighbours keep the plain quality loop until the
-            // rebalancing learns which patches a neighbour touches.
-            let rounds = if has_neighbour[k] { 0 } else { budget };
-            decompose_alone(m, opts, budget.max(1), rounds)
+            decompose_object(surf, opts, budget.max(1), budget, near_k)
         })
         .collect();
     // Meshes' own interpenetration.

@@ -22,9 +22,11 @@
 //! segment under it is fine, since the merged hull's top is the rim. Scenes are Z-up by the
 //! time they are decomposed.
 //!
-//! Applied to objects without neighbours only (see `decompose_scene`): on the `ball_bowl`
-//! scene, a rebalanced bowl let MuJoCo roll the ball 0.6 mm while Rapier held it (merges
-//! only), and with the border moves Rapier rolled it 7 mm.
+//! Next to neighbours, the patches within reach of a neighbour or, facing down, of the ground
+//! are pinned (see [`pinned`]): on the `ball_bowl` scene, a bowl rebalanced everywhere let
+//! MuJoCo roll the ball 0.6 mm and turn it 1.02° while Rapier held it (merges only; with the
+//! border moves Rapier rolled it 7 mm). Pinning only the patches near the ball changed
+//! nothing; pinning the bowl's foot too gave back the motion of no rebalancing (0.32 mm).
 //!
 //! Merged hulls are cached by the pair of patch ids (a patch gets a new id when it changes),
 //! so a round builds only the merges next to the three patches it changed.
@@ -44,7 +46,9 @@ pub(super) fn rebalance(
     opts: &DecomposeOptions,
     parts: &mut Vec<Part>,
     rounds: usize,
+    near: &[f64],
 ) -> usize {
+    let pinned = |tris: &[u32], dev: f64| pinned(near, tris, dev, p, opts);
     let mut ids: Vec<u64> = (0..parts.len() as u64).collect();
     let mut next_id = parts.len() as u64;
     let mut merged: BTreeMap<(u64, u64), Option<Part>> = BTreeMap::new();
@@ -60,7 +64,11 @@ pub(super) fn rebalance(
             break;
         }
         let Some(w) = (0..parts.len())
-            .filter(|&i| parts[i].tris.len() >= 2 && !stuck.contains(&ids[i]))
+            .filter(|&i| {
+                parts[i].tris.len() >= 2
+                    && !stuck.contains(&ids[i])
+                    && !pinned(&parts[i].tris, parts[i].dev)
+            })
             .max_by(|&i, &j| parts[i].dev.total_cmp(&parts[j].dev).then(j.cmp(&i)))
         else {
             break;
@@ -110,7 +118,10 @@ pub(super) fn rebalance(
             .iter()
             .filter_map(|&(i, j)| {
                 let m = merged.get(&(ids[i], ids[j]))?.as_ref()?;
-                allowed(i, j, m).then_some((m.dev, i, j))
+                let free = [&parts[i], &parts[j], m]
+                    .iter()
+                    .all(|q| !pinned(&q.tris, q.dev));
+                (allowed(i, j, m) && free).then_some((m.dev, i, j))
             })
             .min_by(|a, b| a.0.total_cmp(&b.0).then((a.1, a.2).cmp(&(b.1, b.2))));
         // Move 1: merge the best pair, split w.
@@ -131,6 +142,9 @@ pub(super) fn rebalance(
                     };
                     let (a, b) = split(s, f, p, opts, &both)?;
                     let ok = a.dev.max(b.dev) < worst
+                        && !pinned(&parts[j].tris, parts[j].dev)
+                        && !pinned(&a.tris, a.dev)
+                        && !pinned(&b.tris, b.dev)
                         && lift(s, &a.hull, &a.tris) <= top(w, j)
                         && lift(s, &b.hull, &b.tris) <= top(w, j);
                     ok.then_some((a.dev.max(b.dev), j, a, b))
@@ -166,6 +180,23 @@ pub(super) fn rebalance(
         kept += 1;
     }
     kept
+}
+
+/// Whether a patch (`tris`, its hull deviating `dev`) is within reach of the ground or a
+/// neighbour (`near`: per triangle, see `contact_distances`): its hull may bulge `dev` past
+/// its surface, a quarter more for sampling. Pinned patches are not merged, moved or split
+/// by the rebalancing.
+pub(super) fn pinned(
+    near: &[f64],
+    tris: &[u32],
+    dev: f64,
+    p: &Params,
+    opts: &DecomposeOptions,
+) -> bool {
+    !near.is_empty() && {
+        let reach = opts.clearance + 1.25 * dev.max(p.tol);
+        tris.iter().any(|&t| near[t as usize] <= reach)
+    }
 }
 
 /// How far the hull's surface lies above the patch's up-facing triangles (normal within

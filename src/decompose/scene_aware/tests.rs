@@ -389,3 +389,56 @@ fn rebalancing_lowers_the_worst_deviation_at_the_same_budget() {
     }
     assert!(improved >= 1, "rebalancing helped nowhere");
 }
+
+/// Next to a neighbour, the rebalancing leaves the patches the neighbour (or, facing down, the
+/// ground) may touch exactly as the quality loop made them, and still rebalances the rest: a
+/// ball resting in the bowl, 0.75 mm above its floor.
+#[test]
+fn rebalancing_next_to_a_neighbour_keeps_the_patches_it_may_touch() {
+    let o = opts();
+    let mesh = bowl();
+    let dims = shapes::bowl_dims(0.08, 0.055, 0.004);
+    let r = 0.03;
+    let lift = nalgebra::Matrix4::new_translation(&V3::new(0.0, 0.0, dims.floor_z + 7.5e-4 + r));
+    let ball = shapes::uv_sphere(r, 16, 32).transformed(&lift);
+    let s = Surface::new(&mesh).unwrap();
+    let nb = Surface::new(&ball).unwrap();
+    let near = contact_distances(&s, 0.0, &[&nb], &o);
+    let budget = o.max_hulls - o.max_hulls / 8;
+    let off = decompose_object(Surface::new(&mesh), &o, budget, 0, &near);
+    let on = decompose_object(Surface::new(&mesh), &o, budget, budget, &near);
+    assert!(on.report.rebalance_rounds > 0, "nothing rebalanced");
+    let p = on.params.unwrap();
+    let mut kept = 0;
+    for part in &on.parts {
+        if rebalance::pinned(&near, &part.tris, part.dev, &p, &o) {
+            assert!(
+                off.parts
+                    .iter()
+                    .any(|q| q.tris == part.tris && q.hull == part.hull),
+                "a pinned patch changed"
+            );
+            kept += 1;
+        }
+    }
+    // The floor under the ball and the foot on the ground at least.
+    assert!(kept >= 2, "{kept} pinned patches");
+    // Unpinned, the same bowl's rebalancing changes some of those patches.
+    let free = decompose_object(Surface::new(&mesh), &o, budget, budget, &[]);
+    let changed = off
+        .parts
+        .iter()
+        .filter(|q| rebalance::pinned(&near, &q.tris, q.dev, &p, &o))
+        .filter(|q| {
+            !free
+                .parts
+                .iter()
+                .any(|f| f.tris == q.tris && f.hull == q.hull)
+        })
+        .count();
+    eprintln!(
+        "rounds {} pinned {kept}, changed when unpinned {changed} ({} rounds)",
+        on.report.rebalance_rounds, free.report.rebalance_rounds
+    );
+    assert!(changed > 0, "the pin protected nothing");
+}
