@@ -191,6 +191,8 @@ fn main() {
                 scenes.extend(scene_from(&p, s.split('/').nth(1).unwrap(), vec![]));
             }
         }
+        // Last, so the reference runs kept in a --ref-dir keep their scene numbers.
+        scenes.extend(fixture_scene("shelf_item", vec![0, 1]));
     }
 
     // Reference engines through Python, all objects of all scenes at once.

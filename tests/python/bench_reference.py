@@ -103,7 +103,13 @@ def main():
             previous = json.load(f)
     except (OSError, ValueError):
         pass
-    names = sorted(n[:-4] for n in os.listdir(a.inp) if n.endswith(".obj"))
+    # Inputs only: with --in and --out the same folder (bench_decompose --ref-dir), the hulls
+    # written there are .obj files too.
+    names = sorted(
+        n[:-4]
+        for n in os.listdir(a.inp)
+        if n.endswith(".obj") and not n.endswith(".hulls.obj")
+    )
     for name in names:
         vs, fs = read_obj(os.path.join(a.inp, name + ".obj"))
         results[name] = {}
