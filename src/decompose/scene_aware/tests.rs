@@ -442,3 +442,36 @@ fn rebalancing_next_to_a_neighbour_keeps_the_patches_it_may_touch() {
     );
     assert!(changed > 0, "the pin protected nothing");
 }
+
+/// A mesh made of closed convex pieces (a shelf of two panels and three boards) gets one exact
+/// hull per piece: the hulls' volumes add up to the shelf's analytic volume, and no sampled
+/// point of their surfaces is off the mesh.
+#[test]
+fn convex_pieces_of_a_mesh_get_one_exact_hull_each() {
+    let o = opts();
+    let (w, d, h, t) = (0.4, 0.25, 0.5, 0.018);
+    let mesh = shapes::shelf(w, d, h, t, &[0.1, 0.25, 0.4]);
+    let (hulls, rep) = decompose_scene(&[&mesh], &o);
+    assert_eq!(hulls[0].len(), 5, "{:?}", rep.objects[0]);
+    assert_eq!(rep.objects[0].quality_splits, 0);
+    let vol: f64 = hulls[0].iter().map(|h| h.volume).sum();
+    let expect = shapes::shelf_volume(w, d, h, t, 3);
+    assert!((vol - expect).abs() <= 1e-9 * expect, "{vol} vs {expect}");
+    let q = metrics::measure(&mesh, &hulls[0]);
+    assert!(q.dist_max <= 1e-9, "{q:?}");
+    assert!(q.uncovered == 0.0, "{q:?}");
+    // One piece that is not convex (a bowl) next to a convex one (a box beside it): the box
+    // keeps its exact hull, the bowl is decomposed as usual.
+    let mut two = bowl();
+    let cube = shapes::cuboid(V3::new(0.05, 0.05, 0.05))
+        .transformed(&nalgebra::Translation3::new(0.2, 0.0, 0.025).to_homogeneous());
+    two.append(&cube);
+    let (hulls, _) = decompose_scene(&[&two], &o);
+    assert!(hulls[0].len() > 2);
+    assert!(
+        hulls[0]
+            .iter()
+            .any(|h| h.vertices.len() == 8 && (h.volume - 0.05f64.powi(3)).abs() < 1e-12),
+        "the box's own hull"
+    );
+}
