@@ -17,7 +17,7 @@
 //!    hulls (step 2) instead leave seams whose rest facets differ from engine to engine: a
 //!    ball in a bowl settled 2.5 mm apart in Rapier and MuJoCo with them.
 //!    A mesh of several closed pieces (a shelf of boards) gives each convex piece its exact
-//!    hull first ([`convex_components`]); only the other pieces go on to step 2.
+//!    hull first (`convex_components`); only the other pieces go on to step 2.
 //! 2. **Wall-segment / surface-patch hulls** otherwise. Change from the suggested design: a
 //!    pure surface patch on a thin wall bulges *through* the wall into the cavity (its chord),
 //!    and covering the outer and inner sides separately halves the budget per side. So each
