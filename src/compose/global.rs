@@ -315,9 +315,7 @@ pub fn recentred(p: &Problem, t: &Similarity, probe_g: &[usize], iterations: usi
 
 /// Pattern search on the rank over turns of the object about its centre: ±15°, ±7.5°, ±3.75°
 /// about the object's x, y and z axes, each step size until no turn improves the rank (at most
-/// three rounds). With `shift` > 0 the object is also moved along the guidance frame's axes,
-/// by `shift` × the guidance diagonal at the 15° step and proportionally less at the finer ones.
-/// Returns the best pose found and its rank.
+/// three rounds). Returns the best pose found and its rank.
 pub fn climb_rotation(
     p: &Problem,
     t: Similarity,
@@ -325,33 +323,19 @@ pub fn climb_rotation(
     probe_g: &[usize],
     probe_o: &[usize],
     colour: bool,
-    shift: f64,
 ) -> (Similarity, f64) {
     let c = p.object_obb.center;
     let mut best = (t, rank);
     for deg in [15.0f64, 7.5, 3.75] {
-        let step = shift * p.guidance_diagonal() * deg / 15.0;
         for _ in 0..3 {
             let base = best;
             for axis in [V3::x_axis(), V3::y_axis(), V3::z_axis()] {
                 for sign in [-1.0, 1.0] {
                     let turn = UnitQuaternion::from_axis_angle(&axis, sign * deg.to_radians());
-                    let mut cands = vec![spun(&base.0, &turn, &c)];
-                    if step > 0.0 {
-                        cands.push(Similarity {
-                            translation: base.0.translation + sign * step * axis.into_inner(),
-                            ..base.0
-                        });
-                    }
-                    if step > 0.0 && axis == V3::x_axis() {
-                        let f = 1.0 + sign * 4.0 * shift * deg / 15.0;
-                        cands.push(super::scale::rescaled(&base.0, base.0.scale * f, &c));
-                    }
-                    for cand in cands {
-                        let r = fit(p, &cand, probe_g, probe_o).rank(colour);
-                        if r > best.1 {
-                            best = (cand, r);
-                        }
+                    let cand = spun(&base.0, &turn, &c);
+                    let r = fit(p, &cand, probe_g, probe_o).rank(colour);
+                    if r > best.1 {
+                        best = (cand, r);
                     }
                 }
             }
@@ -361,27 +345,6 @@ pub fn climb_rotation(
         }
     }
     best
-}
-
-/// The `n` best-ranked poses of `ranked` whose rotations differ pairwise by more than
-/// `min_angle` (radians), best first; ties keep the earlier pose.
-pub fn distinct_best(ranked: &[(Similarity, f64)], n: usize, min_angle: f64) -> Vec<Similarity> {
-    let mut order: Vec<usize> = (0..ranked.len()).collect();
-    order.sort_by(|&a, &b| ranked[b].1.total_cmp(&ranked[a].1).then(a.cmp(&b)));
-    let mut out: Vec<Similarity> = Vec::new();
-    for i in order {
-        if out.len() == n {
-            break;
-        }
-        let t = ranked[i].0;
-        if out
-            .iter()
-            .all(|b| b.rotation.angle_to(&t.rotation) > min_angle)
-        {
-            out.push(t);
-        }
-    }
-    out
 }
 
 /// Refine every hypothesis with a short ICP and rank it ([`Fit::rank`]); then turn the best
@@ -407,40 +370,16 @@ pub fn best_hypothesis(
         (t, fit(p, &t, &probe_g, &probe_o).rank(colour))
     };
     let mut results: Vec<(Similarity, f64)> = hyps.par_iter().map(refine_and_rank).collect();
-    // The OBB scale is often 10–25% too large (holes and a fused strip of the neighbour tilt
-    // and stretch the guidance part's box), and from there trimmed ICP does not find its way
-    // back: it keeps the fused strip. So the best two distinct poses are also tried at scales
-    // 12%, 25% and 40% smaller and 12% and 25% larger (each a fixed-scale short ICP, ranked).
-    let bases = distinct_best(&results, 2, 0.2);
-    let sweep: Vec<Similarity> = bases
-        .iter()
-        .flat_map(|b| {
-            [1.0 / 1.4, 1.0 / 1.25, 1.0 / 1.12, 1.12, 1.25]
-                .into_iter()
-                .map(move |f| (*b, f))
-        })
-        .filter_map(|(b, f)| {
-            let s = (b.scale * f).clamp(icp.scale_lo, icp.scale_hi);
-            ((s / b.scale - 1.0).abs() > 0.05)
-                .then(|| super::scale::rescaled(&b, s, &p.object_obb.center))
-        })
-        .collect();
-    let swept: Vec<(Similarity, f64)> = sweep
-        .par_iter()
-        .map(|h| {
-            let fixed = IcpOptions {
-                iterations: 20,
-                scale_lo: h.scale,
-                scale_hi: h.scale,
-                ..*icp
-            };
-            let (t, _) = trimmed_icp(&p.object.points, matcher, &g_short, *h, &fixed);
-            (t, fit(p, &t, &probe_g, &probe_o).rank(colour))
-        })
-        .collect();
-    results.extend(swept);
-    let bases = distinct_best(&results, 2, 0.2);
-    // The same two poses turned in place and ranked on coarse probes.
+    // The best few distinct poses, turned in place and ranked on coarse probes.
+    let mut order: Vec<usize> = (0..results.len()).collect();
+    order.sort_by(|&a, &b| results[b].1.total_cmp(&results[a].1).then(a.cmp(&b)));
+    let mut bases: Vec<Similarity> = Vec::new();
+    for &i in &order {
+        let t = results[i].0;
+        if bases.len() < 2 && bases.iter().all(|b| b.rotation.angle_to(&t.rotation) > 0.2) {
+            bases.push(t);
+        }
+    }
     // Axis turns around both bases; the SO(3) samples around the best one only (about its
     // centre they already cover every orientation).
     let axis_turns = spins(&p.object_obb, 0, p.seed);
@@ -482,28 +421,6 @@ pub fn best_hypothesis(
         .map(|(t, _)| refine_and_rank(t))
         .collect();
     results.extend(more);
-    // ICP barely turns a textured near-sphere (a plum, a ball): its geometry pulls nowhere and
-    // its colour pairs pull weakly, so a start 10–30° from the truth stays there and ranks below
-    // a wrong pose whose shape fits. The eight turned starts are therefore also turned by a
-    // pattern search on the rank itself (±15°, ±7.5°, ±3.75° about each axis, on the coarse
-    // probes), which colour decides when geometry cannot; then the best three distinct poses of
-    // all get the same search on the full probes.
-    let coarse_climbed: Vec<(Similarity, f64)> = distinct
-        .par_iter()
-        .map(|(t, r)| {
-            let (t, _) = climb_rotation(p, *t, *r, &coarse_g, &coarse_o, colour, 0.0);
-            (t, fit(p, &t, &probe_g, &probe_o).rank(colour))
-        })
-        .collect();
-    results.extend(coarse_climbed);
-    let climbed: Vec<(Similarity, f64)> = distinct_best(&results, 3, 20f64.to_radians())
-        .par_iter()
-        .map(|t| {
-            let r = fit(p, t, &probe_g, &probe_o).rank(colour);
-            climb_rotation(p, *t, r, &probe_g, &probe_o, colour, 0.01)
-        })
-        .collect();
-    results.extend(climbed);
     results
         .into_iter()
         .enumerate()
@@ -514,63 +431,6 @@ pub fn best_hypothesis(
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn rank_climb_turns_a_textured_sphere_back_by_its_print() {
-        // A sphere with a print that no rotation maps onto itself; its guidance is the whole
-        // sphere placed by `truth`. Started turned by 25° about a slanted axis, with the right
-        // centre and scale, the geometry has no pull at all (every turn of a sphere fits), so
-        // only the colour can turn it back: the climb on the rank must end within 5°.
-        let mesh = crate::shapes::uv_sphere(0.5, 24, 48);
-        let vis = crate::shapes::visual(
-            &mesh,
-            crate::shapes::UvProjection::Spherical { repeat: 1.0 },
-            crate::shapes::textured_material(
-                "print",
-                crate::compose::synth::asymmetric_texture(40, "test"),
-            ),
-        );
-        let mut object = Cloud::sample(&vis, 5000, 1);
-        let truth = Similarity {
-            scale: 1.3,
-            rotation: UnitQuaternion::from_euler_angles(0.4, -0.3, 1.2),
-            translation: V3::new(0.2, -0.5, 1.0),
-        };
-        let mut guidance = Cloud::sample(&vis, 2500, 2).transformed(&truth.matrix());
-        crate::compose::colour::normalise(&mut object);
-        crate::compose::colour::normalise(&mut guidance);
-        let (ot, gt) = (KdTree::new(&object.points), KdTree::new(&guidance.points));
-        let p = Problem {
-            object: &object,
-            object_tree: &ot,
-            guidance: &guidance,
-            guidance_tree: &gt,
-            object_obb: Obb::of_points(&object.points),
-            guidance_obb: Obb::of_points(&guidance.points),
-            scale0: 1.3,
-            seed: 5,
-        };
-        let axis = nalgebra::Unit::new_normalize(V3::new(1.0, 2.0, -0.5));
-        let turn = UnitQuaternion::from_axis_angle(&axis, 25f64.to_radians());
-        let start = spun(&truth, &turn, &p.object_obb.center);
-        assert!((start.rotation.angle_to(&truth.rotation).to_degrees() - 25.0).abs() < 1e-6);
-        let (pg, po) = (probes(guidance.len(), 700), probes(object.len(), 700));
-        let r0 = fit(&p, &start, &pg, &po).rank(true);
-        let (t, r) = climb_rotation(&p, start, r0, &pg, &po, true, 0.0);
-        let err = t.rotation.angle_to(&truth.rotation).to_degrees();
-        assert!(err < 5.0, "climbed to {err:.1}° (rank {r0:.3} -> {r:.3})");
-        // The geometry alone cannot tell: the turned start explains the guidance as well as the
-        // truth does (up to sampling), so the rank rose through the colour term only.
-        let (fs, ft) = (fit(&p, &start, &pg, &po), fit(&p, &truth, &pg, &po));
-        assert!(
-            (fs.guidance_explained - ft.guidance_explained).abs() < 0.02,
-            "{fs:?} {ft:?}"
-        );
-        assert!(
-            ft.colour_explained > fs.colour_explained + 0.1,
-            "{fs:?} {ft:?}"
-        );
-    }
 
     #[test]
     fn turning_in_place_keeps_the_centre_and_composes_the_rotation() {

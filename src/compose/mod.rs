@@ -247,34 +247,6 @@ fn name_seed(seed: u64, name: &str) -> u64 {
     h ^ seed.wrapping_mul(0x9E37_79B9_7F4A_7C15)
 }
 
-/// How much of the rank ICP may give up for precision before its result is refused: the rank
-/// counts probes within τ = 2% of the diagonal, so a converged ICP can lose a few of them while
-/// getting closer on the rest; losing 5% of the probes means it has walked off the ranked pose
-/// (a thin board or book pulled several per cent too small, a ball turned off its print).
-const RANK_SLACK: f64 = 0.05;
-
-/// The rank ([`global::Fit::rank`]) of pose `t` of `object` on `guidance`, on the probes
-/// registration ranks with.
-fn fit_rank(object: &Cloud, guidance: &Cloud, t: &Similarity, colour: bool, seed: u64) -> f64 {
-    let object_tree = KdTree::new(&object.points);
-    let guidance_tree = KdTree::new(&guidance.points);
-    let object_obb = Obb::of_points(&object.points);
-    let guidance_obb = Obb::of_points(&guidance.points);
-    let p = Problem {
-        object,
-        object_tree: &object_tree,
-        guidance,
-        guidance_tree: &guidance_tree,
-        object_obb,
-        guidance_obb,
-        scale0: obb::scale_ratio(&object_obb, &guidance_obb),
-        seed,
-    };
-    let probe_g = global::probes(guidance.len(), 700);
-    let probe_o = global::probes(object.len(), 700);
-    global::fit(&p, t, &probe_g, &probe_o).rank(colour)
-}
-
 /// Register one object onto its guidance part (steps 2–4).
 fn register(
     object: &Cloud,
@@ -355,37 +327,22 @@ fn register(
             .unwrap_or(hyps[0])
     };
     let g_icp = guidance.subsample(1500);
+    let (t, rms) = trimmed_icp(&object.points, &matcher, &g_icp, init, &icp);
     let probe_g = global::probes(guidance.len(), 700);
     let probe_o = global::probes(object.len(), 700);
-    let rank = |t: &Similarity| global::fit(&p, t, &probe_g, &probe_o).rank(use_colour);
-    let (t, rms) = trimmed_icp(&object.points, &matcher, &g_icp, init, &icp);
-    // ICP minimises its own residual, not the rank: on a thin book with holes at its rim it can
-    // slide several per cent too small, so with ranked hypotheses its result is refused when it
-    // ranks more than RANK_SLACK below its start.
-    let (t, rms) = if hyps.len() > 1 && rank(&t) < rank(&init) - RANK_SLACK {
-        (init, rms)
-    } else {
-        (t, rms)
-    };
     let (t, rms) = if matches!(method, Method::IcpOnly | Method::RansacIcp) {
         (t, rms)
     } else {
         let (t, _) = scale::search(
             &p, &matcher, &g_icp, t, &icp, use_colour, &probe_g, &probe_o,
         );
-        // Free ICP again, its scale now held within ±1.5% of the chosen one (refused when it
-        // ranks more than RANK_SLACK lower, as above).
+        // Free ICP again, its scale now held within ±1.5% of the chosen one.
         let near = IcpOptions {
             scale_lo: t.scale / 1.015,
             scale_hi: t.scale * 1.015,
             ..icp
         };
-        let (u, rms_u) = trimmed_icp(&object.points, &matcher, &g_icp, t, &near);
-        if rank(&u) >= rank(&t) - RANK_SLACK {
-            (u, rms_u)
-        } else {
-            (t, rms)
-        }
+        trimmed_icp(&object.points, &matcher, &g_icp, t, &near)
     };
     let score = global::score(&p, &t, use_colour, &probe_g, &probe_o);
     (
@@ -477,16 +434,6 @@ pub fn compose(inputs: &[ObjectInput], o: &ComposeOptions) -> Result<Composition
                     keep: 0.8,
                 };
                 let mut r = refine(&sub.points, &target, t, f, unit, &o.refine);
-                // Guard: pulled towards the guidance by its own correspondences, a pose can be
-                // dragged off what registration ranked best (a textured fruit turned by the data
-                // term, a symmetric shape) while the overlap is removed. The alternative is the
-                // least move that removes the overlap (no move without overlap); the refined
-                // pose is kept only when it fits the guidance at least as well.
-                let least = refine(&sub.points, &Target::InitialPose, t, f, unit, &o.refine);
-                let rank = |t: &Similarity| fit_rank(&object, &guidance, t, colour_used, seed);
-                if rank(&least.transform) > rank(&r.transform) {
-                    r = least;
-                }
                 // Dense check: 700 samples miss thin parts between them (a shoe's edge stayed
                 // 1.5 mm inside the tray). The object's vertices within the clearance band join
                 // the samples for a second pass that removes what is left while moving the
