@@ -538,7 +538,7 @@ fn convex_components(s: &Surface, opts: &DecomposeOptions, budget: usize) -> (Ve
             let pts: Vec<P3> = vs.iter().map(|&v| s.mesh.vertices[v as usize]).collect();
             let local = |v: u32| vs.binary_search(&v).unwrap_or(0) as u32;
             let m = Mesh::new(
-                pts.clone(),
+                pts,
                 tris.iter()
                     .map(|&t| s.mesh.triangles[t as usize].map(local))
                     .collect(),
@@ -546,7 +546,7 @@ fn convex_components(s: &Surface, opts: &DecomposeOptions, budget: usize) -> (Ve
             if !m.is_closed() {
                 return None;
             }
-            let hull = Hull::from_points(&pts)?;
+            let hull = Hull::from_points(&m.vertices)?;
             let vol = m.signed_volume().abs();
             if hull.vertices.len() > opts.max_vertices
                 || (hull.volume - vol).abs() > 1e-6 * hull.volume
@@ -773,10 +773,10 @@ fn contact_distances(
             } else {
                 f64::INFINITY
             };
+            let probe = crate::mesh::Aabb { min: c, max: c };
             nbs.iter()
                 .map(|nb| {
                     let pad = r + opts.tolerance * nb.diag;
-                    let probe = crate::mesh::Aabb { min: c, max: c };
                     if !nb.aabb.intersects(&probe, far + pad) {
                         return f64::INFINITY;
                     }

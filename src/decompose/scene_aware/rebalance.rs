@@ -48,7 +48,7 @@ pub(super) fn rebalance(
     rounds: usize,
     near: &[f64],
 ) -> usize {
-    let pinned = |tris: &[u32], dev: f64| pinned(near, tris, dev, p, opts);
+    let is_pinned = |tris: &[u32], dev: f64| pinned(near, tris, dev, p, opts);
     let mut ids: Vec<u64> = (0..parts.len() as u64).collect();
     let mut next_id = parts.len() as u64;
     let mut merged: BTreeMap<(u64, u64), Option<Part>> = BTreeMap::new();
@@ -67,7 +67,7 @@ pub(super) fn rebalance(
             .filter(|&i| {
                 parts[i].tris.len() >= 2
                     && !stuck.contains(&ids[i])
-                    && !pinned(&parts[i].tris, parts[i].dev)
+                    && !is_pinned(&parts[i].tris, parts[i].dev)
             })
             .max_by(|&i, &j| parts[i].dev.total_cmp(&parts[j].dev).then(j.cmp(&i)))
         else {
@@ -120,7 +120,7 @@ pub(super) fn rebalance(
                 let m = merged.get(&(ids[i], ids[j]))?.as_ref()?;
                 let free = [&parts[i], &parts[j], m]
                     .iter()
-                    .all(|q| !pinned(&q.tris, q.dev));
+                    .all(|q| !is_pinned(&q.tris, q.dev));
                 (allowed(i, j, m) && free).then_some((m.dev, i, j))
             })
             .min_by(|a, b| a.0.total_cmp(&b.0).then((a.1, a.2).cmp(&(b.1, b.2))));
@@ -142,9 +142,9 @@ pub(super) fn rebalance(
                     };
                     let (a, b) = split(s, f, p, opts, &both)?;
                     let ok = a.dev.max(b.dev) < worst
-                        && !pinned(&parts[j].tris, parts[j].dev)
-                        && !pinned(&a.tris, a.dev)
-                        && !pinned(&b.tris, b.dev)
+                        && !is_pinned(&parts[j].tris, parts[j].dev)
+                        && !is_pinned(&a.tris, a.dev)
+                        && !is_pinned(&b.tris, b.dev)
                         && lift(s, &a.hull, &a.tris) <= top(w, j)
                         && lift(s, &b.hull, &b.tris) <= top(w, j);
                     ok.then_some((a.dev.max(b.dev), j, a, b))
