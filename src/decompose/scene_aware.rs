@@ -71,7 +71,7 @@ use std::sync::Mutex;
 /// Engine name, recorded in reports and in the cache key.
 pub const NAME: &str = "scene_aware";
 /// Bumped whenever the output for the same input changes (invalidates the cache).
-pub const VERSION: u32 = 5;
+pub const VERSION: u32 = 6;
 
 /// What happened to one object.
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
@@ -86,6 +86,10 @@ pub struct ObjectReport {
     /// budget was spent.
     #[serde(default)]
     pub rebalance_rounds: usize,
+    /// The patches were found top-down, with plane cuts across the object's principal axes,
+    /// which measured closer to the surface than the bottom-up patches (see `Strategy`).
+    #[serde(default)]
+    pub top_down: bool,
     /// Patch splits made because a hull met a neighbour.
     pub neighbour_splits: usize,
     /// Plane cuts against neighbours that removed only bulge (no surface vertex).
@@ -232,10 +236,51 @@ struct Params {
     lambda: f64,
     merge_depth: f64,
     n_outer: usize,
+    strategy: Strategy,
+}
+
+/// How an object's patches are found. For an object alone, [`decompose_object`] runs both and
+/// keeps the one whose hulls lie closer to the surface (95th percentile), as neither wins on
+/// every shape:
+/// * `Patches` starts bottom-up from `budget / 2` k-means surface patches and splits the worst
+///   across its own principal directions. Best on the YCB mug (p95 3.29 % against 3.50 %).
+/// * `Planes` starts top-down from 2 patches, and may also cut a patch by planes normal to the
+///   scene's axes at a quarter, half and three quarters of the patch's extent, as CoACD cuts
+///   by axis-aligned planes. Objects are prepared Z-up, so the horizontal cuts follow what a
+///   standing object has level: a cup's foot ring, recessed floor and rim lip become bands,
+///   where patch-local cuts made pie slices. YCB cup p95 2.81 → 2.04 %, mug fixture
+///   1.02 → 0.82 % (alone). The object's own principal axes did worse (mug fixture 0.90 %,
+///   sneaker 2.41 against 2.10 %): their horizontal pair is arbitrary on a round object.
+///
+/// Next to a neighbour only `Patches` runs. Its contact geometry is what the MuJoCo agreement
+/// tests hold; the plane cuts put seams where a neighbour rests. On `ball_bowl` the halving
+/// planes split the floor in four through the ball's resting point, a pit of four tilted
+/// chords, and MuJoCo rolled the ball 2.6 mm in 2 s (limit 1 mm). Cuts at thirds or
+/// quarters instead failed Rapier's own validation of `ball_bowl` or `pen_mug`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Strategy {
+    Patches,
+    Planes,
+}
+
+/// Where [`Strategy::Planes`] cuts a patch along each axis, as fractions of its extent.
+const PLANE_FRACTIONS: [f64; 3] = [0.25, 0.5, 0.75];
+
+impl Strategy {
+    /// Both, in the order ties are broken.
+    const ALL: [Strategy; 2] = [Strategy::Patches, Strategy::Planes];
+
+    /// How many k-means patches the quality loop starts from.
+    fn initial_patches(self, budget: usize) -> usize {
+        match self {
+            Strategy::Patches => (budget / 2).max(1),
+            Strategy::Planes => (budget / 16).max(1),
+        }
+    }
 }
 
 impl Params {
-    fn new(s: &Surface, opts: &DecomposeOptions) -> Params {
+    fn new(s: &Surface, opts: &DecomposeOptions, strategy: Strategy) -> Params {
         let tol = opts.tolerance * s.diag;
         let d_min = 1.5 * opts.min_thickness;
         Params {
@@ -245,6 +290,7 @@ impl Params {
             lambda: 0.1 * s.diag,
             merge_depth: 0.03 * s.diag,
             n_outer: (opts.max_vertices / 2).max(4),
+            strategy,
         }
     }
 }
@@ -642,6 +688,31 @@ fn split(
             cands.push((a, b));
         }
     }
+    if p.strategy == Strategy::Planes {
+        for axis in [V3::x(), V3::y(), V3::z()] {
+            let x: Vec<f64> = part
+                .tris
+                .iter()
+                .map(|&t| axis.dot(&s.tri_centroid[t as usize].coords))
+                .collect();
+            let lo = x.iter().copied().fold(f64::INFINITY, f64::min);
+            let hi = x.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+            for frac in PLANE_FRACTIONS {
+                let c = lo + frac * (hi - lo);
+                let (a, b): (Vec<(u32, f64)>, Vec<(u32, f64)>) = part
+                    .tris
+                    .iter()
+                    .copied()
+                    .zip(x.iter().copied())
+                    .partition(|e| e.1 < c);
+                let a: Vec<u32> = a.into_iter().map(|e| e.0).collect();
+                let b: Vec<u32> = b.into_iter().map(|e| e.0).collect();
+                if !a.is_empty() && !b.is_empty() && !cands.iter().any(|c| c.0 == a) {
+                    cands.push((a, b));
+                }
+            }
+        }
+    }
     let built: Vec<Option<(Part, Part)>> = cands
         .into_par_iter()
         .map(|(a, b)| {
@@ -668,8 +739,14 @@ fn split(
 /// Decompose one object alone. `budget`: most hulls the quality loop may use; `rounds`: most
 /// rebalancing rounds once it is spent (see [`rebalance`]).
 #[cfg(test)]
-fn decompose_alone(mesh: &Mesh, opts: &DecomposeOptions, budget: usize, rounds: usize) -> Obj {
-    decompose_object(Surface::new(mesh), opts, budget, rounds, &[])
+fn decompose_alone(
+    mesh: &Mesh,
+    opts: &DecomposeOptions,
+    budget: usize,
+    rounds: usize,
+    strategies: &[Strategy],
+) -> Obj {
+    decompose_object(Surface::new(mesh), opts, budget, rounds, &[], strategies)
 }
 
 /// [`decompose_alone`] on a prepared surface. `near[t]`: a lower bound on how far triangle
@@ -681,6 +758,7 @@ fn decompose_object(
     budget: usize,
     rounds: usize,
     near: &[f64],
+    strategies: &[Strategy],
 ) -> Obj {
     let Some(s) = surf.as_ref() else {
         return Obj {
@@ -691,27 +769,92 @@ fn decompose_object(
             report: ObjectReport::default(),
         };
     };
-    let p = Params::new(s, opts);
-    let mut report = ObjectReport::default();
+    let p = Params::new(s, opts, Strategy::Patches);
     if let Some(parts) = shortcut(s, &p, opts, budget) {
-        report.convex_shortcut = true;
         return Obj {
             parts,
             feat: None,
             surf,
             params: Some(p),
-            report,
+            report: ObjectReport {
+                convex_shortcut: true,
+                ..Default::default()
+            },
         };
     }
-    let (mut parts, rest) = convex_components(s, opts, budget);
-    let k0 = (budget.saturating_sub(parts.len()) / 2).max(1);
+    let (fixed, rest) = convex_components(s, opts, budget);
     let feat = patches::Features::new(s, p.merge_depth, p.d_max);
+    let run = |strategy: Strategy| {
+        let p = Params::new(s, opts, strategy);
+        let (parts, report) = grow_parts(s, &feat, &p, opts, &fixed, &rest, budget, rounds, near);
+        (parts, report, p)
+    };
+    let strategies = if rest.is_empty() {
+        &strategies[..strategies.len().min(1)]
+    } else {
+        strategies
+    };
+    // Closest at the 95th percentile; ties keep the earlier strategy.
+    let (parts, mut report, p) = strategies
+        .par_iter()
+        .map(|&st| {
+            let r = run(st);
+            (p95_distance(s, &r.0), r)
+        })
+        .collect::<Vec<_>>()
+        .into_iter()
+        .reduce(|a, b| if b.0 < a.0 { b } else { a })
+        .map(|x| x.1)
+        .unwrap_or_else(|| run(Strategy::Patches));
+    report.top_down = p.strategy == Strategy::Planes;
+    Obj {
+        parts,
+        feat: Some(feat),
+        surf,
+        params: Some(p),
+        report,
+    }
+}
+
+/// 95th percentile of the sampled distance from the parts' union boundary to the surface: what
+/// [`decompose_object`] chooses a strategy by (the bench's measure, on fewer samples).
+fn p95_distance(s: &Surface, parts: &[Part]) -> f64 {
+    let hulls: Vec<Hull> = parts.iter().map(|q| q.hull.clone()).collect();
+    let mut d = metrics::surface_distances(s, &hulls, P95_SAMPLES);
+    if d.is_empty() {
+        return f64::INFINITY;
+    }
+    d.sort_by(f64::total_cmp);
+    d[(d.len() * 95 / 100).min(d.len() - 1)]
+}
+
+const P95_SAMPLES: usize = 4000;
+
+/// The parts of one strategy: the closed convex components `fixed` as they are, the remaining
+/// triangles `rest` as k-means patches split by the quality loop, then rebalanced.
+#[allow(clippy::too_many_arguments)]
+fn grow_parts(
+    s: &Surface,
+    feat: &patches::Features,
+    p: &Params,
+    opts: &DecomposeOptions,
+    fixed: &[Part],
+    rest: &[u32],
+    budget: usize,
+    rounds: usize,
+    near: &[f64],
+) -> (Vec<Part>, ObjectReport) {
+    let mut report = ObjectReport::default();
+    let mut parts = fixed.to_vec();
     if !rest.is_empty() {
-        let groups = patches::kmeans(s, &feat, &rest, k0, p.lambda, 16);
+        let k0 = p
+            .strategy
+            .initial_patches(budget.saturating_sub(parts.len()));
+        let groups = patches::kmeans(s, feat, rest, k0, p.lambda, 16);
         parts.extend(
             groups
                 .into_par_iter()
-                .filter_map(|g| build_part(s, &p, opts, g, Vec::new()))
+                .filter_map(|g| build_part(s, p, opts, g, Vec::new()))
                 .collect::<Vec<_>>(),
         );
     }
@@ -722,7 +865,7 @@ fn decompose_object(
             .filter(|&i| !unsplittable[i] && parts[i].dev > p.tol)
             .max_by(|&i, &j| parts[i].dev.total_cmp(&parts[j].dev).then(j.cmp(&i)));
         let Some(w) = worst else { break };
-        match split(s, &feat, &p, opts, &parts[w]) {
+        match split(s, feat, p, opts, &parts[w]) {
             Some((a, b)) => {
                 parts[w] = a;
                 parts.push(b);
@@ -733,16 +876,9 @@ fn decompose_object(
         }
     }
     if parts.len() >= budget {
-        report.rebalance_rounds =
-            rebalance::rebalance(s, &feat, &p, opts, &mut parts, rounds, near);
+        report.rebalance_rounds = rebalance::rebalance(s, feat, p, opts, &mut parts, rounds, near);
     }
-    Obj {
-        parts,
-        feat: Some(feat),
-        surf,
-        params: Some(p),
-        report,
-    }
+    (parts, report)
 }
 
 /// For each triangle of `s`, a lower bound on its distance to what the object touches: the
@@ -943,7 +1079,13 @@ pub fn decompose_scene(
             } else {
                 opts.max_hulls
             };
-            decompose_object(surf, opts, budget.max(1), budget, near_k)
+            // Next to a neighbour only the bottom-up patches: see `Strategy`.
+            let strategies: &[Strategy] = if has_neighbour[k] {
+                &[Strategy::Patches]
+            } else {
+                &Strategy::ALL
+            };
+            decompose_object(surf, opts, budget.max(1), budget, near_k, strategies)
         })
         .collect();
     // Meshes' own interpenetration.
