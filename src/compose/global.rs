@@ -7,6 +7,7 @@ use super::features::{fpfh, match_features};
 use super::icp::{trimmed_icp, umeyama, IcpOptions, Matcher};
 use super::kdtree::KdTree;
 use super::obb::{axis_permutations, Obb};
+use super::occlusion::Occlusion;
 use crate::mesh::{P3, V3};
 use crate::pose::Similarity;
 use crate::rng::Rng;
@@ -24,6 +25,8 @@ pub struct Problem<'a> {
     /// Scale from the OBB extents.
     pub scale0: f64,
     pub seed: u64,
+    /// The other objects of the scene, which hide parts of this one ([`Occlusion`]).
+    pub occlusion: Option<&'a Occlusion<'a>>,
 }
 
 impl Problem<'_> {
@@ -174,7 +177,9 @@ pub struct Fit {
     pub guidance_explained: f64,
     /// The same, each inlier weighted by colour agreement (Gaussian, σ = 0.12 per channel).
     pub colour_explained: f64,
-    /// Fraction of object points with a guidance point within τ.
+    /// Fraction of object points with a guidance point within τ, over the points whose guidance
+    /// could be there: an uncovered point that the other objects hide ([`Occlusion`]) is left
+    /// out, as contact or occlusion explains its missing guidance.
     pub object_covered: f64,
 }
 
@@ -219,20 +224,28 @@ pub fn fit(p: &Problem, t: &Similarity, probe_g: &[usize], probe_o: &[usize]) ->
             }
         }
     }
-    let mut back = 0.0;
+    let (mut back, mut seen) = (0.0, 0.0);
     for &oi in probe_o {
         let q = m.transform_point(&p.object.points[oi]);
-        if let Some((_, d2)) = p.guidance_tree.nearest(&q) {
-            if d2.sqrt() < tau {
-                back += 1.0;
-            }
+        let covered = p
+            .guidance_tree
+            .nearest(&q)
+            .is_some_and(|(_, d2)| d2.sqrt() < tau);
+        if covered {
+            back += 1.0;
+            seen += 1.0;
+        } else if !p
+            .occlusion
+            .is_some_and(|o| o.hidden(&q, &(t.rotation * p.object.normals[oi])))
+        {
+            seen += 1.0;
         }
     }
     let ng = probe_g.len().max(1) as f64;
     Fit {
         guidance_explained: geo / ng,
         colour_explained: col / ng,
-        object_covered: back / probe_o.len().max(1) as f64,
+        object_covered: if seen > 0.0 { back / seen } else { 0.0 },
     }
 }
 

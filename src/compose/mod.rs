@@ -25,6 +25,7 @@ pub mod global;
 pub mod icp;
 pub mod kdtree;
 pub mod obb;
+pub mod occlusion;
 pub mod refine;
 pub mod scale;
 pub mod sdf;
@@ -42,6 +43,7 @@ use icp::{trimmed_icp, IcpOptions};
 pub const COLOUR_WEIGHT: f64 = 0.1;
 use kdtree::KdTree;
 use obb::Obb;
+use occlusion::Occlusion;
 use refine::{refine, RefineOptions, Refined, Target};
 use sdf::AnchorField;
 use serde::Serialize;
@@ -247,10 +249,12 @@ fn name_seed(seed: u64, name: &str) -> u64 {
     h ^ seed.wrapping_mul(0x9E37_79B9_7F4A_7C15)
 }
 
-/// Register one object onto its guidance part (steps 2–4).
+/// Register one object onto its guidance part (steps 2–4). `occlusion` holds the other objects
+/// of the scene, which hide parts of this one ([`Occlusion`]).
 fn register(
     object: &Cloud,
     guidance: &Cloud,
+    occlusion: Option<&Occlusion<'_>>,
     method: Method,
     seed: u64,
 ) -> (Similarity, String, f64, f64, f64, usize, bool) {
@@ -268,6 +272,7 @@ fn register(
         guidance_obb,
         scale0,
         seed,
+        occlusion,
     };
     let icp = IcpOptions {
         iterations: 60,
@@ -396,17 +401,52 @@ pub fn compose(inputs: &[ObjectInput], o: &ComposeOptions) -> Result<Composition
         order.insert(0, k);
     }
     let unit = bb.diagonal();
+    // Every guidance part is sampled up front: the others' parts are what hides an object until
+    // they are placed ([`Occlusion`]).
+    let guidances: Vec<Cloud> = inputs
+        .iter()
+        .map(|inp| {
+            let seed = name_seed(o.seed, &inp.name);
+            let mut g = Cloud::sample(&inp.guidance, o.guidance_samples, seed ^ 1);
+            colour::normalise(&mut g);
+            g
+        })
+        .collect();
+    // Surface samples of the objects placed so far, at their composed poses.
+    let mut placed_samples: Vec<Option<Vec<P3>>> = vec![None; inputs.len()];
     let mut field: Option<AnchorField> = None;
     let mut results = Vec::new();
     for (rank, &i) in order.iter().enumerate() {
         let inp = &inputs[i];
         let seed = name_seed(o.seed, &inp.name);
         let mut object = Cloud::sample(&inp.visual, o.object_samples, seed);
-        let mut guidance = Cloud::sample(&inp.guidance, o.guidance_samples, seed ^ 1);
+        let guidance = &guidances[i];
         colour::normalise(&mut object);
-        colour::normalise(&mut guidance);
+        // What hides this object: the placed meshes of the objects composed before it
+        // (complete surfaces), the guidance parts of the others (holey).
+        let occlusion = crate::mesh::Aabb::of_points(&guidance.points).map(|b| {
+            let d = b.diagonal();
+            // Blockers more than a diagonal away hide little; the cells are 2τ wide.
+            let reach = crate::mesh::Aabb {
+                min: b.min - nalgebra::Vector3::repeat(d),
+                max: b.max + nalgebra::Vector3::repeat(d),
+            };
+            let blockers: Vec<P3> = (0..inputs.len())
+                .filter(|&j| j != i)
+                .flat_map(|j| match &placed_samples[j] {
+                    Some(pts) => pts.clone(),
+                    None => guidances[j].subsample(800).points,
+                })
+                .filter(|p| (0..3).all(|k| p[k] >= reach.min[k] && p[k] <= reach.max[k]))
+                .collect();
+            let o = Occlusion::new(blockers, &b, 0.25 * d, 0.04 * d);
+            match &field {
+                Some(f) => o.with_solids(f, 0.02 * d),
+                None => o,
+            }
+        });
         let (mut t, mut method, scale0, score, rms, n_hyp, colour_used) =
-            register(&object, &guidance, o.method, seed);
+            register(&object, guidance, occlusion.as_ref(), o.method, seed);
         let mut refinement = None;
         // The object's welded mesh, built once for the dense check and the anchor field.
         let geometry = std::cell::OnceCell::new();
@@ -468,6 +508,13 @@ pub fn compose(inputs: &[ObjectInput], o: &ComposeOptions) -> Result<Composition
             let placed: Mesh = geometry().transformed(&t.matrix());
             let fld = field.get_or_insert_with(|| AnchorField::new(&[], 32));
             fld.push(&placed, 32);
+        }
+        if rank + 1 < order.len() {
+            placed_samples[i] = Some(
+                Cloud::sample(&inp.visual, 800, seed ^ 2)
+                    .transformed(&t.matrix())
+                    .points,
+            );
         }
         results.push(ObjectResult {
             name: inp.name.clone(),

@@ -128,6 +128,7 @@ mod tests {
             guidance_obb: Obb::of_points(&guidance.points),
             scale0: 2.0,
             seed: 3,
+            occlusion: None,
         };
         let icp = IcpOptions {
             iterations: 60,
