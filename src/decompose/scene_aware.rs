@@ -36,6 +36,9 @@
 //!    distances) is split while that exceeds the tolerance and the budget lasts; a split tries
 //!    2-means and area-median cuts across the two PCA axes and keeps the one whose worse half
 //!    deviates least. Objects with neighbours keep `max_hulls/8` of the budget for step 3.
+//!    An object alone also runs a second strategy, `Strategy::Planes` (top-down from 2 patches, with plane cuts
+//!    across the scene axes among the split candidates) and keeps whichever lies closer to the
+//!    surface at the 95th percentile.
 //! 3. **Neighbour refinement** at the composed pose. Every pair of hulls of different objects
 //!    closer than `clearance` (exact convex–convex queries in f64) is resolved: when the
 //!    convex hulls of the two patches' *surface points* are apart, both hulls are clipped by
