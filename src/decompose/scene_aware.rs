@@ -89,8 +89,8 @@ pub struct ObjectReport {
     /// budget was spent.
     #[serde(default)]
     pub rebalance_rounds: usize,
-    /// The patches were found top-down, with plane cuts across the object's principal axes,
-    /// which measured closer to the surface than the bottom-up patches (see `Strategy`).
+    /// The patches were found top-down, with plane cuts normal to the scene axes, which
+    /// measured closer to the surface than the bottom-up patches (see `Strategy`).
     #[serde(default)]
     pub top_down: bool,
     /// Patch splits made because a hull met a neighbour.
@@ -460,9 +460,12 @@ fn shortcut(s: &Surface, p: &Params, opts: &DecomposeOptions, budget: usize) -> 
     // The first that meets the tolerance wins, in that order.
     let deviation = |h: &Hull| -> Option<(f64, f64)> {
         let samples = geom::sample_hull(h, 512, 0x5eed);
-        let mut d: Vec<f64> = samples.par_iter().map(|q| s.distance(q)).collect();
-        d.sort_by(f64::total_cmp);
-        Some((d[(d.len() * 95 / 100).min(d.len() - 1)], *d.last()?))
+        let d: Vec<f64> = samples.par_iter().map(|q| s.distance(q)).collect();
+        if d.is_empty() {
+            return None;
+        }
+        let (_, p95, max) = metrics::stats(&d);
+        Some((p95, max))
     };
     // A little of the volume lost to simplification is given back by a uniform scale about the
     // centroid (keeps faces planar and level), capped at a quarter of the tolerance at the
@@ -823,12 +826,11 @@ fn decompose_object(
 /// [`decompose_object`] chooses a strategy by (the bench's measure, on fewer samples).
 fn p95_distance(s: &Surface, parts: &[Part]) -> f64 {
     let hulls: Vec<Hull> = parts.iter().map(|q| q.hull.clone()).collect();
-    let mut d = metrics::surface_distances(s, &hulls, P95_SAMPLES);
+    let d = metrics::surface_distances(s, &hulls, P95_SAMPLES);
     if d.is_empty() {
         return f64::INFINITY;
     }
-    d.sort_by(f64::total_cmp);
-    d[(d.len() * 95 / 100).min(d.len() - 1)]
+    metrics::stats(&d).1
 }
 
 const P95_SAMPLES: usize = 4000;
@@ -1131,11 +1133,11 @@ pub fn decompose_scene(
     // Sampled surface distance and remaining overlaps.
     for (k, o) in objs.iter_mut().enumerate() {
         if let Some(s) = &o.surf {
-            let mut d = metrics::surface_distances(s, &hulls[k], 128 * hulls[k].len());
-            d.sort_by(f64::total_cmp);
+            let d = metrics::surface_distances(s, &hulls[k], 128 * hulls[k].len());
             if !d.is_empty() {
-                o.report.distance_p95 = d[(d.len() * 95 / 100).min(d.len() - 1)];
-                o.report.distance_max = d[d.len() - 1];
+                let (_, p95, max) = metrics::stats(&d);
+                o.report.distance_p95 = p95;
+                o.report.distance_max = max;
             }
         }
     }
