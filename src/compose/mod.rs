@@ -427,17 +427,13 @@ pub fn compose(inputs: &[ObjectInput], o: &ComposeOptions) -> Result<Composition
         let occlusion = crate::mesh::Aabb::of_points(&guidance.points).map(|b| {
             let d = b.diagonal();
             // Blockers more than a diagonal away hide little; the cells are 2τ wide.
-            let reach = crate::mesh::Aabb {
-                min: b.min - nalgebra::Vector3::repeat(d),
-                max: b.max + nalgebra::Vector3::repeat(d),
-            };
             let blockers: Vec<P3> = (0..inputs.len())
                 .filter(|&j| j != i)
                 .flat_map(|j| match &placed_samples[j] {
                     Some(pts) => pts.clone(),
                     None => guidances[j].subsample(800).points,
                 })
-                .filter(|p| (0..3).all(|k| p[k] >= reach.min[k] && p[k] <= reach.max[k]))
+                .filter(|p| b.intersects(&crate::mesh::Aabb { min: *p, max: *p }, d))
                 .collect();
             let o = Occlusion::new(blockers, &b, 0.25 * d, 0.04 * d);
             match &field {
