@@ -37,8 +37,10 @@
 //!    2-means and area-median cuts across the two PCA axes and keeps the one whose worse half
 //!    deviates least. Objects with neighbours keep `max_hulls/8` of the budget for step 3.
 //!    An object alone also runs a second strategy, `Strategy::Planes` (top-down from 2 patches, with plane cuts
-//!    across the scene axes among the split candidates) and keeps whichever lies closer to the
-//!    surface at the 95th percentile.
+//!    across the scene axes among the split candidates), polishes both once the budget is spent
+//!    (`polish.rs`: moves that bring the far tail of the surface distance closer, where the
+//!    loop above chases each hull's maximum) and keeps whichever lies closer to the surface at
+//!    the 95th percentile.
 //! 3. **Neighbour refinement** at the composed pose. Every pair of hulls of different objects
 //!    closer than `clearance` (exact convex–convex queries in f64) is resolved: when the
 //!    convex hulls of the two patches' *surface points* are apart, both hulls are clipped by
@@ -61,6 +63,7 @@
 pub mod geom;
 pub mod metrics;
 pub mod patches;
+mod polish;
 mod rebalance;
 
 use super::{cache, DecomposeOptions, Decomposer, Hull};
@@ -74,7 +77,7 @@ use std::sync::Mutex;
 /// Engine name, recorded in reports and in the cache key.
 pub const NAME: &str = "scene_aware";
 /// Bumped whenever the output for the same input changes (invalidates the cache).
-pub const VERSION: u32 = 6;
+pub const VERSION: u32 = 7;
 
 /// What happened to one object.
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
@@ -89,6 +92,12 @@ pub struct ObjectReport {
     /// budget was spent.
     #[serde(default)]
     pub rebalance_rounds: usize,
+    /// Moves of the polishing (see `polish.rs`, objects alone) that brought the far tail of
+    /// the surface distance closer once the budget was spent, and patches it trimmed first.
+    #[serde(default)]
+    pub polish_rounds: usize,
+    #[serde(default)]
+    pub trimmed_patches: usize,
     /// The patches were found top-down, with plane cuts normal to the scene axes, which
     /// measured closer to the surface than the bottom-up patches (see `Strategy`).
     #[serde(default)]
@@ -266,7 +275,8 @@ enum Strategy {
     Planes,
 }
 
-/// Where [`Strategy::Planes`] cuts a patch along each axis, as fractions of its extent.
+/// Where [`Strategy::Planes`] cuts a patch along each axis, as fractions of its extent (and
+/// the polishing along the patch's principal axes, as fractions of its area).
 const PLANE_FRACTIONS: [f64; 3] = [0.25, 0.5, 0.75];
 
 impl Strategy {
@@ -632,10 +642,9 @@ fn convex_components(s: &Surface, opts: &DecomposeOptions, budget: usize) -> (Ve
     (parts, rest)
 }
 
-/// Split a part's patch in two; `None` when it cannot be split. Three candidate splits are
-/// built — 2-means in feature space and area-median cuts across the two main axes of the patch
-/// (PCA of the mid-wall positions) — and the one whose worse half deviates least is kept: a
-/// concave patch is thus cut across its most curved direction, which halves its sagitta fastest.
+/// Split a part's patch in two; `None` when it cannot be split. Of the candidate splits (see
+/// [`split_candidates`]) the one whose worse half deviates least is kept: a concave patch is
+/// thus cut across its most curved direction, which halves its sagitta fastest.
 fn split(
     s: &Surface,
     f: &patches::Features,
@@ -643,14 +652,38 @@ fn split(
     opts: &DecomposeOptions,
     part: &Part,
 ) -> Option<(Part, Part)> {
+    split_candidates(s, f, p, opts, part, false)
+        .into_iter()
+        .enumerate()
+        .min_by(|(i, x), (j, y)| {
+            x.0.dev
+                .max(x.1.dev)
+                .total_cmp(&y.0.dev.max(y.1.dev))
+                .then(i.cmp(j))
+        })
+        .map(|(_, x)| x)
+}
+
+/// The ways of splitting a part's patch in two, built, in a fixed order: 2-means in feature
+/// space, area-median cuts across the two main axes of the patch (PCA of the mid-wall
+/// positions), and for [`Strategy::Planes`] cuts by planes normal to the scene axes. `fine`
+/// (the polishing) adds cuts at a quarter and three quarters of the area along the principal
+/// axes, and the plane cuts whatever the strategy.
+fn split_candidates(
+    s: &Surface,
+    f: &patches::Features,
+    p: &Params,
+    opts: &DecomposeOptions,
+    part: &Part,
+    fine: bool,
+) -> Vec<(Part, Part)> {
     if part.tris.len() < 2 {
-        return None;
+        return Vec::new();
     }
     let mut cands: Vec<(Vec<u32>, Vec<u32>)> = Vec::new();
     let halves = patches::kmeans(s, f, &part.tris, 2, p.lambda, 12);
-    if halves.len() == 2 {
-        let mut it = halves.into_iter();
-        cands.push((it.next()?, it.next()?));
+    if let [a, b] = &halves[..] {
+        cands.push((a.clone(), b.clone()));
     }
     // PCA of the area-weighted mid-wall positions.
     let w: f64 = part.tris.iter().map(|&t| s.tri_area[t as usize]).sum();
@@ -678,23 +711,26 @@ fn split(
                 .map(|&t| (axis.dot(&f.pos[t as usize].coords), t))
                 .collect();
             by.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
-            let mut acc = 0.0;
-            let mut cut = by.len() / 2;
-            for (i, &(_, t)) in by.iter().enumerate() {
-                acc += s.tri_area[t as usize];
-                if acc >= 0.5 * w {
-                    cut = (i + 1).clamp(1, by.len() - 1);
-                    break;
+            let fracs: &[f64] = if fine { &PLANE_FRACTIONS } else { &[0.5] };
+            for &frac in fracs {
+                let mut acc = 0.0;
+                let mut cut = by.len() / 2;
+                for (i, &(_, t)) in by.iter().enumerate() {
+                    acc += s.tri_area[t as usize];
+                    if acc >= frac * w {
+                        cut = (i + 1).clamp(1, by.len() - 1);
+                        break;
+                    }
                 }
+                let mut a: Vec<u32> = by[..cut].iter().map(|x| x.1).collect();
+                let mut b: Vec<u32> = by[cut..].iter().map(|x| x.1).collect();
+                a.sort_unstable();
+                b.sort_unstable();
+                cands.push((a, b));
             }
-            let mut a: Vec<u32> = by[..cut].iter().map(|x| x.1).collect();
-            let mut b: Vec<u32> = by[cut..].iter().map(|x| x.1).collect();
-            a.sort_unstable();
-            b.sort_unstable();
-            cands.push((a, b));
         }
     }
-    if p.strategy == Strategy::Planes {
+    if p.strategy == Strategy::Planes || fine {
         for axis in [V3::x(), V3::y(), V3::z()] {
             let x: Vec<f64> = part
                 .tris
@@ -729,17 +765,7 @@ fn split(
             Some((pa?, pb?))
         })
         .collect();
-    built
-        .into_iter()
-        .flatten()
-        .enumerate()
-        .min_by(|(i, x), (j, y)| {
-            x.0.dev
-                .max(x.1.dev)
-                .total_cmp(&y.0.dev.max(y.1.dev))
-                .then(i.cmp(j))
-        })
-        .map(|(_, x)| x)
+    built.into_iter().flatten().collect()
 }
 
 /// Decompose one object alone. `budget`: most hulls the quality loop may use; `rounds`: most
@@ -882,6 +908,10 @@ fn grow_parts(
     }
     if parts.len() >= budget {
         report.rebalance_rounds = rebalance::rebalance(s, feat, p, opts, &mut parts, rounds, near);
+        if near.is_empty() {
+            (report.trimmed_patches, report.polish_rounds) =
+                polish::polish(s, feat, p, opts, &mut parts, rounds);
+        }
     }
     (parts, report)
 }

@@ -79,15 +79,7 @@ pub(super) fn rebalance(
         }
         let adj = adjacency(s, parts);
         // Adjacent pairs, w excluded, in index order.
-        let pairs: Vec<(usize, usize)> = (0..parts.len())
-            .filter(|&i| i != w)
-            .flat_map(|i| {
-                adj[i]
-                    .iter()
-                    .filter(move |&&j| j > i && j != w)
-                    .map(move |&j| (i, j))
-            })
-            .collect();
+        let pairs: Vec<(usize, usize)> = adjacent_pairs(&adj, w);
         // How far each hull rises above its patch's up-facing triangles.
         let lifts: Vec<f64> = parts.iter().map(|q| lift(s, &q.hull, &q.tris)).collect();
         let missing: Vec<(usize, usize)> = pairs
@@ -202,7 +194,7 @@ pub(super) fn pinned(
 /// How far the hull's surface lies above the patch's up-facing triangles (normal within
 /// about 25° of +Z): the largest distance, straight up from a triangle's centroid, to where
 /// it leaves the hull. 0 when the patch has none.
-fn lift(s: &Surface, h: &crate::decompose::Hull, tris: &[u32]) -> f64 {
+pub(super) fn lift(s: &Surface, h: &crate::decompose::Hull, tris: &[u32]) -> f64 {
     let mut worst: f64 = 0.0;
     for &t in tris {
         if s.tri_normal[t as usize].z < SUPPORT_NZ {
@@ -222,8 +214,21 @@ fn lift(s: &Surface, h: &crate::decompose::Hull, tris: &[u32]) -> f64 {
     worst
 }
 
+/// The pairs of adjacent patches (`i < j`), `w` excluded, in index order.
+pub(super) fn adjacent_pairs(adj: &[Vec<usize>], w: usize) -> Vec<(usize, usize)> {
+    (0..adj.len())
+        .filter(|&i| i != w)
+        .flat_map(|i| {
+            adj[i]
+                .iter()
+                .filter(move |&&j| j > i && j != w)
+                .map(move |&j| (i, j))
+        })
+        .collect()
+}
+
 /// The triangles of two patches, ascending.
-fn union(a: &Part, b: &Part) -> Vec<u32> {
+pub(super) fn union(a: &Part, b: &Part) -> Vec<u32> {
     let mut tris = a.tris.clone();
     tris.extend_from_slice(&b.tris);
     tris.sort_unstable();
@@ -231,7 +236,7 @@ fn union(a: &Part, b: &Part) -> Vec<u32> {
 }
 
 /// For each patch, the patches sharing a mesh vertex with it, ascending.
-fn adjacency(s: &Surface, parts: &[Part]) -> Vec<Vec<usize>> {
+pub(super) fn adjacency(s: &Surface, parts: &[Part]) -> Vec<Vec<usize>> {
     let mut owner: Vec<Vec<usize>> = vec![Vec::new(); s.mesh.vertices.len()];
     for (k, part) in parts.iter().enumerate() {
         for &t in &part.tris {

@@ -341,6 +341,12 @@ fn cone_pieces_are_exactly_the_hull() {
     assert!(geom::cone_pieces(&full, 64, 3).is_none());
 }
 
+/// `near` for a mesh with neighbours none of which is within reach of it: nothing is pinned,
+/// and the polishing (objects alone) does not run.
+fn unpinned(mesh: &Mesh) -> Vec<f64> {
+    vec![f64::INFINITY; mesh.triangles.len()]
+}
+
 /// Rebalancing keeps the hull count and never raises the worst deviation; on shapes where the
 /// binary splits left the patches uneven it lowers it. Measured independently of the engine's
 /// own `dev` (64 samples per hull): the union-boundary distances of `metrics`.
@@ -361,8 +367,13 @@ fn rebalancing_lowers_the_worst_deviation_at_the_same_budget() {
     for strategy in &Strategy::ALL {
         let mut improved = 0;
         for (name, mesh, budget) in &shapes_ {
-            let off = decompose_alone(mesh, &o, *budget, 0, &[*strategy]);
-            let on = decompose_alone(mesh, &o, *budget, *budget, &[*strategy]);
+            // Nothing within reach: the rebalancing as for an object alone, without the
+            // polishing that follows it there.
+            let far = unpinned(mesh);
+            let run = |rounds| {
+                decompose_object(Surface::new(mesh), &o, *budget, rounds, &far, &[*strategy])
+            };
+            let (off, on) = (run(0), run(*budget));
             let hulls = |x: &Obj| x.parts.iter().map(|p| p.hull.clone()).collect::<Vec<_>>();
             let (h_off, h_on) = (hulls(&off), hulls(&on));
             assert_eq!(h_off.len(), h_on.len(), "{name}");
@@ -534,4 +545,67 @@ fn top_down_plane_cuts_win_alone_on_level_featured_containers() {
         &o,
     );
     assert!(!rep.objects[0].top_down, "plane cuts next to a neighbour");
+}
+
+/// The polishing (objects alone) lowers the 95th percentile of the distance from the union's
+/// boundary to the surface, at the same hull budget and limits, with the cavity open: measured
+/// on 20,000 samples, independently of the 8,000 the polishing chose its moves on. Never worse
+/// (1 % slack for the sampling), and on the YCB cup (p95 2.04 → 1.66 % of the diagonal) by
+/// 15 % at least. The mug fixture is already within the tolerance: nothing to polish.
+#[test]
+fn polishing_lowers_the_95th_percentile_alone() {
+    let o = opts();
+    let mut cases: Vec<(&str, Mesh, f64)> = vec![
+        (
+            "bowl fixture",
+            world_meshes(&fixture("ball_bowl")).remove(0),
+            1.01,
+        ),
+        (
+            "mug fixture",
+            world_meshes(&fixture("pen_mug")).remove(0),
+            1.0,
+        ),
+    ];
+    if let Some(sh) = shared() {
+        let p = sh.join("datasets/objects/ycb/065-j_cups/textured.obj");
+        if let Ok(v) = crate::io::load_visual(&p, &crate::io::Limits::default()) {
+            cases.push(("YCB cup", v.geometry(), 0.85));
+        }
+    }
+    let b = o.max_hulls;
+    for (name, mesh, ratio) in &cases {
+        let far = unpinned(mesh);
+        let off = decompose_object(Surface::new(mesh), &o, b, b, &far, &Strategy::ALL);
+        let on = decompose_alone(mesh, &o, b, b, &Strategy::ALL);
+        let hulls = |x: &Obj| x.parts.iter().map(|p| p.hull.clone()).collect::<Vec<_>>();
+        let (h_off, h_on) = (hulls(&off), hulls(&on));
+        assert_limits(&h_on, &o);
+        assert_eq!(h_on.len(), h_off.len(), "{name}: same budget");
+        let (q_off, q_on) = (
+            metrics::measure(mesh, &h_off),
+            metrics::measure(mesh, &h_on),
+        );
+        eprintln!(
+            "{name}: p95 {:.3} % -> {:.3} % ({} moves)",
+            q_off.dist_p95 * 100.0,
+            q_on.dist_p95 * 100.0,
+            on.report.polish_rounds
+        );
+        assert!(
+            q_on.dist_p95 <= ratio * q_off.dist_p95,
+            "{name}: {} -> {}",
+            q_off.dist_p95,
+            q_on.dist_p95
+        );
+        assert_eq!(q_on.cavity_kept, Some(true), "{name}");
+        if *ratio == 1.0 {
+            assert_eq!(
+                h_on, h_off,
+                "{name}: within the tolerance, nothing to polish"
+            );
+        } else {
+            assert!(on.report.polish_rounds > 0, "{name}");
+        }
+    }
 }

@@ -1,0 +1,386 @@
+//! Polishing a full budget for the 95th percentile, for an object alone.
+//!
+//! The quality loop and the rebalancing (see `rebalance.rs`) chase the *largest* sampled
+//! deviation of a hull, but what a simulator feels, and what the bench measures, is how much
+//! of the collision surface lies far from the mesh: the 95th percentile of the distance from
+//! the union's boundary to the surface. The two disagree on thin containers. On the GSO mug
+//! scan the wall segments whose inner chord bulges most into the cavity (inner spans of 40–55°
+//! against CoACD's 25–35°) were never the worst by their maximum, which sits at the rim or the
+//! foot, so 32 hulls stopped at p95 1.52 % of the diagonal against CoACD's 1.19 %.
+//!
+//! When the parts' p95 distance exceeds the tolerance, the patches are first trimmed (see
+//! [`trim`]), then each round measures, on points sampled once per hull (8,000 over the
+//! union at the start), the union's p95 distance `t` and per hull its *excess*: the area of its
+//! visible surface (outside every other hull) farther than `t` from the mesh. It takes the hull
+//! with the largest excess (w) and tries, like the rebalancing, two moves:
+//!
+//! 1. merge the adjacent pair (i, j ≠ w) whose merge adds least excess, and split w the way
+//!    that leaves least excess, with the freed hull;
+//! 2. else move w's border with one of its 4 neighbours of largest excess: merge the two and
+//!    split them again the way that leaves least excess.
+//!
+//! The ways to split are the quality loop's plus cuts at a quarter and three quarters along
+//! the patch's principal axes and by planes normal to the scene axes (see
+//! `split_candidates`); the 6 whose worse half deviates least have their excess measured.
+//! A move is kept only when the mean of the farthest tenth of the sampled distances drops by
+//! at least 0.2 %: the hull count stays the same and the measured tail never grows. A hull
+//! that no move improves is set aside; the polishing stops after 6 in a row, after `rounds`
+//! moves kept, or when the p95 distance is within the tolerance. Merges and splits may not
+//! lift a hull above its up-facing triangles, as in the rebalancing.
+//!
+//! Both strategies are polished before one is chosen: on the GSO mug the bottom-up patches
+//! came out closer once polished though the top-down ones were closer before. Measured alone
+//! (bench, p95 % of the diagonal, before → after): GSO mug 1.52 → 1.22, YCB cup 2.04 → 1.66,
+//! YCB mug 3.29 → 2.21, sneaker 2.10 → 1.60, YCB bowl 1.48 → 1.39, bowl fixture 1.34 → 1.31;
+//! the mug fixture (0.82) is within the tolerance and left as it is.
+//!
+//! Only for objects alone: next to a neighbour the patches the neighbour may touch are the
+//! contact geometry the agreement tests hold (see `Strategy`).
+
+use super::geom::{sample_hull, Surface};
+use super::patches::Features;
+use super::rebalance::{adjacency, adjacent_pairs, lift, union};
+use super::{build_part, metrics, split_candidates, Params, Part, CONTACT_DEV};
+use crate::decompose::{DecomposeOptions, Hull};
+use rayon::prelude::*;
+use std::collections::BTreeMap;
+use std::sync::Arc;
+
+/// Consecutive hulls that no move improved after which the polishing stops.
+const MAX_FAILS: usize = 6;
+
+/// Of a hull's ways to split in two, how many (the closest by their worse half's largest
+/// deviation) have their excess measured.
+const SHORTLIST: usize = 6;
+
+/// Of w's neighbours, how many (those with the largest excess) move 2 tries.
+const NEIGHBOURS: usize = 4;
+
+/// Points sampled on the hulls' surfaces, in all, when the polishing starts: twice the
+/// strategy choice's, as the moves kept are chosen on them (with 4,000 the p95 measured on
+/// 20,000 others came out 3 % above the polishing's own on the GSO mug).
+const SAMPLES: f64 = 8000.0;
+
+/// The polishing's measure: the mean of the farthest tenth of the sampled distances. Steadier
+/// than the 95th percentile itself, which one move may leave where it was while moving the
+/// tail it sits in.
+const TAIL: f64 = 0.10;
+
+/// Least relative drop of that measure for a move to be kept.
+const MIN_GAIN: f64 = 2e-3;
+
+/// Points on a hull's surface, at the polishing's fixed density, and their distances to the
+/// mesh: computed once per hull, since only which of them are visible changes from move to move.
+struct Samples {
+    pts: Vec<crate::mesh::P3>,
+    dist: Vec<f64>,
+    area: f64,
+}
+
+impl Samples {
+    fn new(s: &Surface, h: &Hull, density: f64) -> Samples {
+        let area = h.mesh().area();
+        let pts = sample_hull(h, ((area * density).ceil() as usize).max(8), 0xd15);
+        let dist = pts.iter().map(|q| s.distance(q)).collect();
+        Samples { pts, dist, area }
+    }
+
+    /// Distances of the points outside every hull of `all` but those at `skip`.
+    fn visible<'a>(
+        &'a self,
+        all: &'a [&Hull],
+        skip: &'a [usize],
+        eps: f64,
+    ) -> impl Iterator<Item = f64> + 'a {
+        self.pts
+            .iter()
+            .zip(&self.dist)
+            .filter(move |(q, _)| {
+                !all.iter()
+                    .enumerate()
+                    .any(|(k, g)| !skip.contains(&k) && g.holds(q, eps))
+            })
+            .map(|(_, d)| *d)
+    }
+
+    /// Area of the visible surface farther than `thr` from the mesh.
+    fn excess(&self, all: &[&Hull], skip: &[usize], eps: f64, thr: f64) -> f64 {
+        let far = self.visible(all, skip, eps).filter(|&d| d > thr).count();
+        self.area * far as f64 / self.pts.len() as f64
+    }
+}
+
+/// A part with its samples.
+type Sampled = (Part, Arc<Samples>);
+
+/// Polish `parts` in place (at most `rounds` kept moves) when their p95 distance exceeds the
+/// tolerance; returns the patches trimmed and the moves kept.
+pub(super) fn polish(
+    s: &Surface,
+    f: &Features,
+    p: &Params,
+    opts: &DecomposeOptions,
+    parts: &mut [Part],
+    rounds: usize,
+) -> (usize, usize) {
+    let eps = 1e-9 * s.diag;
+    let total: f64 = parts.iter().map(|q| q.hull.mesh().area()).sum();
+    if !(total > 0.0) {
+        return (0, 0);
+    }
+    let density = SAMPLES / total;
+    let sampled = |q: Part| -> Sampled {
+        let smp = Samples::new(s, &q.hull, density);
+        (q, Arc::new(smp))
+    };
+    let sample_all = |parts: &[Part]| -> Vec<Arc<Samples>> {
+        parts
+            .par_iter()
+            .map(|q| Arc::new(Samples::new(s, &q.hull, density)))
+            .collect()
+    };
+    let mut smp = sample_all(parts);
+    let mut cur = measure(parts, &smp, eps);
+    if cur.0 <= p.tol {
+        return (0, 0);
+    }
+    let trimmed = trim(s, p, opts, parts);
+    if trimmed > 0 {
+        smp = sample_all(parts);
+        cur = measure(parts, &smp, eps);
+    }
+    let mut ids: Vec<u64> = (0..parts.len() as u64).collect();
+    let mut next_id = parts.len() as u64;
+    // Merges by the pair of part ids; `None`: none, or one lifting a hull above a floor.
+    let mut merged: BTreeMap<(u64, u64), Option<Sampled>> = BTreeMap::new();
+    let mut stuck: Vec<u64> = Vec::new();
+    let (mut kept, mut failed) = (0, 0);
+    for _ in 0..2 * rounds {
+        if kept >= rounds || failed >= MAX_FAILS || parts.len() < 3 || cur.0 <= p.tol {
+            break;
+        }
+        let thr = cur.0;
+        let owned: Vec<Hull> = parts.iter().map(|q| q.hull.clone()).collect();
+        let hulls: Vec<&Hull> = owned.iter().collect();
+        let ex: Vec<f64> = (0..parts.len())
+            .into_par_iter()
+            .map(|i| smp[i].excess(&hulls, &[i], eps, thr))
+            .collect();
+        let Some(w) = (0..parts.len())
+            .filter(|&i| parts[i].tris.len() >= 2 && !stuck.contains(&ids[i]) && ex[i] > 0.0)
+            .max_by(|&i, &j| ex[i].total_cmp(&ex[j]).then(j.cmp(&i)))
+        else {
+            break;
+        };
+        let adj = adjacency(s, parts);
+        let lifts: Vec<f64> = parts.iter().map(|q| lift(s, &q.hull, &q.tris)).collect();
+        let top = |i: usize, j: usize| lifts[i].max(lifts[j]).max(CONTACT_DEV * p.tol);
+        // Of the ways to split in two, the one leaving least excess, with the other hulls but
+        // `skip`.
+        let best_halves = |cands: Vec<(Part, Part)>, skip: &[usize], limit: f64| {
+            let mut cands: Vec<(usize, (Part, Part))> = cands
+                .into_iter()
+                .enumerate()
+                .filter(|(_, (a, b))| {
+                    lift(s, &a.hull, &a.tris) <= limit && lift(s, &b.hull, &b.tris) <= limit
+                })
+                .collect();
+            // Only the closest few by their worse half's deviation are sampled.
+            cands.sort_by(|(i, x), (j, y)| {
+                x.0.dev
+                    .max(x.1.dev)
+                    .total_cmp(&y.0.dev.max(y.1.dev))
+                    .then(i.cmp(j))
+            });
+            cands.truncate(SHORTLIST);
+            cands
+                .into_par_iter()
+                .map(|(k, (a, b))| {
+                    let (a, b) = (sampled(a), sampled(b));
+                    let n = hulls.len();
+                    let mut hs: Vec<&Hull> = hulls.clone();
+                    hs.extend([&a.0.hull, &b.0.hull]);
+                    let skip_a: Vec<usize> = skip.iter().copied().chain([n]).collect();
+                    let skip_b: Vec<usize> = skip.iter().copied().chain([n + 1]).collect();
+                    let e = a.1.excess(&hs, &skip_a, eps, thr) + b.1.excess(&hs, &skip_b, eps, thr);
+                    (e, k, a, b)
+                })
+                .min_by(|x, y| x.0.total_cmp(&y.0).then(x.1.cmp(&y.1)))
+        };
+        // Move 1: the merge adding least excess, w split the way leaving least.
+        let pairs: Vec<(usize, usize)> = adjacent_pairs(&adj, w);
+        let missing: Vec<(usize, usize)> = pairs
+            .iter()
+            .copied()
+            .filter(|&(i, j)| !merged.contains_key(&(ids[i], ids[j])))
+            .collect();
+        // Merges are built once per pair of part ids, and sampled when they may be kept: not
+        // lifting a hull above a floor (see `rebalance`).
+        let built: Vec<Option<Sampled>> = missing
+            .par_iter()
+            .map(|&(i, j)| {
+                let m = build_part(
+                    s,
+                    p,
+                    opts,
+                    union(&parts[i], &parts[j]),
+                    parts[i].cuts.clone(),
+                )?;
+                (lift(s, &m.hull, &m.tris) <= top(i, j)).then(|| sampled(m))
+            })
+            .collect();
+        for (&(i, j), b) in missing.iter().zip(built) {
+            merged.insert((ids[i], ids[j]), b);
+        }
+        let merge = pairs
+            .iter()
+            .filter_map(|&(i, j)| {
+                let (_, ms) = merged.get(&(ids[i], ids[j]))?.as_ref()?;
+                let added = ms.excess(&hulls, &[i, j], eps, thr) - ex[i] - ex[j];
+                Some((added, i, j))
+            })
+            .min_by(|a, b| a.0.total_cmp(&b.0).then((a.1, a.2).cmp(&(b.1, b.2))));
+        let mut trial: Vec<(usize, Sampled)> = Vec::new();
+        if let Some((added, i, j)) = merge {
+            let limit = lifts[w].max(CONTACT_DEV * p.tol);
+            if let Some((e, _, a, b)) = best_halves(
+                split_candidates(s, f, p, opts, &parts[w], true),
+                &[w],
+                limit,
+            ) {
+                if e + added < ex[w] {
+                    let m = merged[&(ids[i], ids[j])].clone().expect("merge was built");
+                    trial = vec![(i, m), (w, a), (j, b)];
+                }
+            }
+        }
+        let mut done = try_move(parts, &mut smp, &trial, &mut cur, eps);
+        if done {
+            for &(k, _) in &trial {
+                ids[k] = next_id;
+                next_id += 1;
+            }
+        } else {
+            // Move 2: w's border with one of the neighbours of largest excess.
+            let mut nb: Vec<usize> = adj[w].clone();
+            nb.sort_by(|&a, &b| ex[b].total_cmp(&ex[a]).then(a.cmp(&b)));
+            nb.truncate(NEIGHBOURS);
+            let best = nb
+                .par_iter()
+                .filter_map(|&j| {
+                    let both = Part {
+                        tris: union(&parts[w], &parts[j]),
+                        ..parts[w].clone()
+                    };
+                    let (e, _, a, b) = best_halves(
+                        split_candidates(s, f, p, opts, &both, true),
+                        &[w, j],
+                        top(w, j),
+                    )?;
+                    (e < ex[w] + ex[j]).then_some((e - ex[w] - ex[j], j, a, b))
+                })
+                .min_by(|x, y| x.0.total_cmp(&y.0).then(x.1.cmp(&y.1)));
+            if let Some((_, j, a, b)) = best {
+                done = try_move(parts, &mut smp, &[(w, a), (j, b)], &mut cur, eps);
+                if done {
+                    for k in [w, j] {
+                        ids[k] = next_id;
+                        next_id += 1;
+                    }
+                }
+            }
+        }
+        if done {
+            kept += 1;
+            failed = 0;
+        } else {
+            failed += 1;
+            stuck.push(ids[w]);
+        }
+    }
+    (trimmed, kept)
+}
+
+/// Apply `trial` (part index, replacement) when it lowers the tail measure of `cur`
+/// (p95, tail) by [`MIN_GAIN`], and update `cur`.
+fn try_move(
+    parts: &mut [Part],
+    smp: &mut [Arc<Samples>],
+    trial: &[(usize, Sampled)],
+    cur: &mut (f64, f64),
+    eps: f64,
+) -> bool {
+    if trial.is_empty() {
+        return false;
+    }
+    let mut next: Vec<Part> = parts.to_vec();
+    let mut next_smp: Vec<Arc<Samples>> = smp.to_vec();
+    for (k, (q, qs)) in trial {
+        next[*k] = q.clone();
+        next_smp[*k] = qs.clone();
+    }
+    let v = measure(&next, &next_smp, eps);
+    if v.1 < cur.1 * (1.0 - MIN_GAIN) {
+        parts.clone_from_slice(&next);
+        smp.clone_from_slice(&next_smp);
+        *cur = v;
+        true
+    } else {
+        false
+    }
+}
+
+/// The 95th percentile of the sampled distances from the parts' union boundary to the mesh,
+/// and the mean of their farthest [`TAIL`] (m).
+fn measure(parts: &[Part], smp: &[Arc<Samples>], eps: f64) -> (f64, f64) {
+    let hulls: Vec<&Hull> = parts.iter().map(|q| &q.hull).collect();
+    let mut d: Vec<f64> = (0..parts.len())
+        .into_par_iter()
+        .flat_map_iter(|i| smp[i].visible(&hulls, &[i], eps).collect::<Vec<_>>())
+        .collect();
+    if d.is_empty() {
+        return (f64::INFINITY, f64::INFINITY);
+    }
+    let p95 = metrics::stats(&d).1;
+    d.sort_by(f64::total_cmp);
+    let k = ((d.len() as f64 * (1.0 - TAIL)) as usize).min(d.len() - 1);
+    (p95, d[k..].iter().sum::<f64>() / (d.len() - k) as f64)
+}
+
+/// Before the moves, each patch (in order) gives up the triangles another part's hull already
+/// holds, when its rebuilt hull deviates no more: patches grown by k-means and binary splits
+/// interleave at their borders, and a hull spans its patch's farthest triangles, so adjacent
+/// wall segments overlapped (on the GSO mug their inner spans added up to 1.7 turns). Returns
+/// the patches trimmed.
+fn trim(s: &Surface, p: &Params, opts: &DecomposeOptions, parts: &mut [Part]) -> usize {
+    let eps = 1e-9 * s.diag;
+    let mut n = 0;
+    for i in 0..parts.len() {
+        if parts[i].tris.len() < 2 {
+            continue;
+        }
+        let held = |t: u32| {
+            let tri = s.mesh.triangle(t as usize);
+            parts
+                .iter()
+                .enumerate()
+                .any(|(k, g)| k != i && tri.iter().all(|q| g.hull.holds(q, eps)))
+        };
+        let keep: Vec<u32> = parts[i]
+            .tris
+            .iter()
+            .copied()
+            .filter(|&t| !held(t))
+            .collect();
+        if keep.len() == parts[i].tris.len() || keep.is_empty() {
+            continue;
+        }
+        if let Some(q) = build_part(s, p, opts, keep, parts[i].cuts.clone()) {
+            if q.dev <= parts[i].dev {
+                parts[i] = q;
+                n += 1;
+            }
+        }
+    }
+    n
+}
