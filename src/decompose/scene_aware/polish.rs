@@ -140,14 +140,14 @@ pub(super) fn polish(
             .collect()
     };
     let mut smp = sample_all(parts);
-    let mut cur = measure(parts, &smp, eps);
+    let mut cur = measure_parts(parts, &smp, eps);
     if cur.0 <= p.tol {
         return (0, 0);
     }
     let trimmed = trim(s, p, opts, parts);
     if trimmed > 0 {
         smp = sample_all(parts);
-        cur = measure(parts, &smp, eps);
+        cur = measure_parts(parts, &smp, eps);
     }
     let mut ids: Vec<u64> = (0..parts.len() as u64).collect();
     let mut next_id = parts.len() as u64;
@@ -313,16 +313,19 @@ fn try_move(
     if trial.is_empty() {
         return false;
     }
-    let mut next: Vec<Part> = parts.to_vec();
-    let mut next_smp: Vec<Arc<Samples>> = smp.to_vec();
+    // Measured on the hulls and samples as they would be; parts change only if kept.
+    let mut hulls: Vec<&Hull> = parts.iter().map(|q| &q.hull).collect();
+    let mut samples: Vec<&Samples> = smp.iter().map(|x| &**x).collect();
     for (k, (q, qs)) in trial {
-        next[*k] = q.clone();
-        next_smp[*k] = qs.clone();
+        hulls[*k] = &q.hull;
+        samples[*k] = qs;
     }
-    let v = measure(&next, &next_smp, eps);
+    let v = measure(&hulls, &samples, eps);
     if v.1 < cur.1 * (1.0 - MIN_GAIN) {
-        parts.clone_from_slice(&next);
-        smp.clone_from_slice(&next_smp);
+        for (k, (q, qs)) in trial {
+            parts[*k] = q.clone();
+            smp[*k] = qs.clone();
+        }
         *cur = v;
         true
     } else {
@@ -332,19 +335,25 @@ fn try_move(
 
 /// The 95th percentile of the sampled distances from the parts' union boundary to the mesh,
 /// and the mean of their farthest [`TAIL`] (m).
-fn measure(parts: &[Part], smp: &[Arc<Samples>], eps: f64) -> (f64, f64) {
-    let hulls: Vec<&Hull> = parts.iter().map(|q| &q.hull).collect();
-    let mut d: Vec<f64> = (0..parts.len())
+fn measure(hulls: &[&Hull], smp: &[&Samples], eps: f64) -> (f64, f64) {
+    let mut d: Vec<f64> = (0..hulls.len())
         .into_par_iter()
-        .flat_map_iter(|i| smp[i].visible(&hulls, &[i], eps).collect::<Vec<_>>())
+        .flat_map_iter(|i| smp[i].visible(hulls, &[i], eps).collect::<Vec<_>>())
         .collect();
     if d.is_empty() {
         return (f64::INFINITY, f64::INFINITY);
     }
-    let p95 = metrics::stats(&d).1;
     d.sort_by(f64::total_cmp);
+    let p95 = metrics::stats(&d).1;
     let k = ((d.len() as f64 * (1.0 - TAIL)) as usize).min(d.len() - 1);
     (p95, d[k..].iter().sum::<f64>() / (d.len() - k) as f64)
+}
+
+/// [`measure`] of the parts with their samples.
+fn measure_parts(parts: &[Part], smp: &[Arc<Samples>], eps: f64) -> (f64, f64) {
+    let hulls: Vec<&Hull> = parts.iter().map(|q| &q.hull).collect();
+    let samples: Vec<&Samples> = smp.iter().map(|x| &**x).collect();
+    measure(&hulls, &samples, eps)
 }
 
 /// Before the moves, each patch (in order) gives up the triangles another part's hull already
