@@ -36,11 +36,12 @@
 //!    distances) is split while that exceeds the tolerance and the budget lasts; a split tries
 //!    2-means and area-median cuts across the two PCA axes and keeps the one whose worse half
 //!    deviates least. Objects with neighbours keep `max_hulls/8` of the budget for step 3.
-//!    An object alone also runs a second strategy, `Strategy::Planes` (top-down from 2 patches, with plane cuts
-//!    across the scene axes among the split candidates), polishes both once the budget is spent
-//!    (`polish.rs`: moves that bring the far tail of the surface distance closer, where the
-//!    loop above chases each hull's maximum) and keeps whichever lies closer to the surface at
-//!    the 95th percentile.
+//!    Once the budget is spent the patches are rebalanced and polished (`rebalance.rs`,
+//!    `polish.rs`: moves that bring the far tail of the surface distance closer, where the
+//!    loop above chases each hull's maximum), next to neighbours with the patches they may
+//!    touch pinned. An object alone also runs a second strategy, `Strategy::Planes` (top-down
+//!    from 2 patches, with plane cuts across the scene axes among the split candidates) and
+//!    keeps whichever lies closer to the surface at the 95th percentile.
 //! 3. **Neighbour refinement** at the composed pose. Every pair of hulls of different objects
 //!    closer than `clearance` (exact convex–convex queries in f64) is resolved: when the
 //!    convex hulls of the two patches' *surface points* are apart, both hulls are clipped by
@@ -77,7 +78,7 @@ use std::sync::Mutex;
 /// Engine name, recorded in reports and in the cache key.
 pub const NAME: &str = "scene_aware";
 /// Bumped whenever the output for the same input changes (invalidates the cache).
-pub const VERSION: u32 = 7;
+pub const VERSION: u32 = 8;
 
 /// What happened to one object.
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
@@ -92,7 +93,7 @@ pub struct ObjectReport {
     /// budget was spent.
     #[serde(default)]
     pub rebalance_rounds: usize,
-    /// Moves of the polishing (see `polish.rs`, objects alone) that brought the far tail of
+    /// Moves of the polishing (see `polish.rs`) that brought the far tail of
     /// the surface distance closer once the budget was spent, and patches it trimmed first.
     #[serde(default)]
     pub polish_rounds: usize,
@@ -768,27 +769,44 @@ fn split_candidates(
     built.into_iter().flatten().collect()
 }
 
-/// Decompose one object alone. `budget`: most hulls the quality loop may use; `rounds`: most
-/// rebalancing rounds once it is spent (see [`rebalance`]).
+/// Once the budget is spent: most moves kept by the rebalancing (see [`rebalance`]) and by the
+/// polishing (see [`polish`]).
+#[derive(Clone, Copy, Debug)]
+struct Effort {
+    rebalance: usize,
+    polish: usize,
+}
+
+impl Effort {
+    /// As many moves of each as hulls in the budget.
+    fn full(budget: usize) -> Effort {
+        Effort {
+            rebalance: budget,
+            polish: budget,
+        }
+    }
+}
+
+/// Decompose one object alone. `budget`: most hulls the quality loop may use.
 #[cfg(test)]
 fn decompose_alone(
     mesh: &Mesh,
     opts: &DecomposeOptions,
     budget: usize,
-    rounds: usize,
+    effort: Effort,
     strategies: &[Strategy],
 ) -> Obj {
-    decompose_object(Surface::new(mesh), opts, budget, rounds, &[], strategies)
+    decompose_object(Surface::new(mesh), opts, budget, effort, &[], strategies)
 }
 
 /// [`decompose_alone`] on a prepared surface. `near[t]`: a lower bound on how far triangle
 /// `t` is from the ground and every neighbour's collision geometry (empty: nothing is
-/// pinned); the rebalancing leaves alone the patches within reach of them.
+/// pinned); the rebalancing and the polishing leave alone the patches within reach of them.
 fn decompose_object(
     surf: Option<Surface>,
     opts: &DecomposeOptions,
     budget: usize,
-    rounds: usize,
+    effort: Effort,
     near: &[f64],
     strategies: &[Strategy],
 ) -> Obj {
@@ -818,7 +836,7 @@ fn decompose_object(
     let feat = patches::Features::new(s, p.merge_depth, p.d_max);
     let run = |strategy: Strategy| {
         let p = Params::new(s, opts, strategy);
-        let (parts, report) = grow_parts(s, &feat, &p, opts, &fixed, &rest, budget, rounds, near);
+        let (parts, report) = grow_parts(s, &feat, &p, opts, &fixed, &rest, budget, effort, near);
         (parts, report, p)
     };
     let strategies = if rest.is_empty() {
@@ -862,7 +880,7 @@ fn p95_distance(s: &Surface, parts: &[Part]) -> f64 {
 const P95_SAMPLES: usize = 4000;
 
 /// The parts of one strategy: the closed convex components `fixed` as they are, the remaining
-/// triangles `rest` as k-means patches split by the quality loop, then rebalanced.
+/// triangles `rest` as k-means patches split by the quality loop, then rebalanced and polished.
 #[allow(clippy::too_many_arguments)]
 fn grow_parts(
     s: &Surface,
@@ -872,7 +890,7 @@ fn grow_parts(
     fixed: &[Part],
     rest: &[u32],
     budget: usize,
-    rounds: usize,
+    effort: Effort,
     near: &[f64],
 ) -> (Vec<Part>, ObjectReport) {
     let mut report = ObjectReport::default();
@@ -907,10 +925,11 @@ fn grow_parts(
         }
     }
     if parts.len() >= budget {
-        report.rebalance_rounds = rebalance::rebalance(s, feat, p, opts, &mut parts, rounds, near);
-        if near.is_empty() {
+        report.rebalance_rounds =
+            rebalance::rebalance(s, feat, p, opts, &mut parts, effort.rebalance, near);
+        if effort.polish > 0 {
             (report.trimmed_patches, report.polish_rounds) =
-                polish::polish(s, feat, p, opts, &mut parts, rounds);
+                polish::polish(s, feat, p, opts, &mut parts, effort.polish, near);
         }
     }
     (parts, report)
@@ -1120,7 +1139,8 @@ pub fn decompose_scene(
             } else {
                 &Strategy::ALL
             };
-            decompose_object(surf, opts, budget.max(1), budget, near_k, strategies)
+            let budget = budget.max(1);
+            decompose_object(surf, opts, budget, Effort::full(budget), near_k, strategies)
         })
         .collect();
     // Meshes' own interpenetration.

@@ -245,7 +245,13 @@ fn real_scenes_hulls_apart() {
         eprintln!("shared datasets not present: skipped");
         return;
     };
-    for s in ["food/00001_lemon_bowl", "toys/00007_ball_mug"] {
+    // The last two: scenes where the polishing next to a neighbour moves patches.
+    for s in [
+        "food/00001_lemon_bowl",
+        "toys/00007_ball_mug",
+        "kitchenware/00008_spoon_mug",
+        "household/00009_bottle_lunchbox",
+    ] {
         check_scene(&shared.join("datasets/scenes").join(s));
     }
 }
@@ -341,12 +347,6 @@ fn cone_pieces_are_exactly_the_hull() {
     assert!(geom::cone_pieces(&full, 64, 3).is_none());
 }
 
-/// `near` for a mesh with neighbours none of which is within reach of it: nothing is pinned,
-/// and the polishing (objects alone) does not run.
-fn unpinned(mesh: &Mesh) -> Vec<f64> {
-    vec![f64::INFINITY; mesh.triangles.len()]
-}
-
 /// Rebalancing keeps the hull count and never raises the worst deviation; on shapes where the
 /// binary splits left the patches uneven it lowers it. Measured independently of the engine's
 /// own `dev` (64 samples per hull): the union-boundary distances of `metrics`.
@@ -367,11 +367,13 @@ fn rebalancing_lowers_the_worst_deviation_at_the_same_budget() {
     for strategy in &Strategy::ALL {
         let mut improved = 0;
         for (name, mesh, budget) in &shapes_ {
-            // Nothing within reach: the rebalancing as for an object alone, without the
-            // polishing that follows it there.
-            let far = unpinned(mesh);
+            // The rebalancing alone, without the polishing that follows it.
             let run = |rounds| {
-                decompose_object(Surface::new(mesh), &o, *budget, rounds, &far, &[*strategy])
+                let effort = Effort {
+                    rebalance: rounds,
+                    polish: 0,
+                };
+                decompose_object(Surface::new(mesh), &o, *budget, effort, &[], &[*strategy])
             };
             let (off, on) = (run(0), run(*budget));
             let hulls = |x: &Obj| x.parts.iter().map(|p| p.hull.clone()).collect::<Vec<_>>();
@@ -403,9 +405,9 @@ fn rebalancing_lowers_the_worst_deviation_at_the_same_budget() {
     }
 }
 
-/// Next to a neighbour, the rebalancing leaves the patches the neighbour (or, facing down, the
-/// ground) may touch exactly as the quality loop made them, and still rebalances the rest: a
-/// ball resting in the bowl, 0.75 mm above its floor.
+/// Next to a neighbour, the rebalancing and the polishing leave the patches the neighbour (or,
+/// facing down, the ground) may touch exactly as the quality loop made them, and still
+/// rebalance the rest: a ball resting in the bowl, 0.75 mm above its floor.
 #[test]
 fn rebalancing_next_to_a_neighbour_keeps_the_patches_it_may_touch() {
     let o = opts();
@@ -420,8 +422,13 @@ fn rebalancing_next_to_a_neighbour_keeps_the_patches_it_may_touch() {
     let budget = o.max_hulls - o.max_hulls / 8;
     for strategy in &Strategy::ALL {
         let st = &[*strategy];
-        let off = decompose_object(Surface::new(&mesh), &o, budget, 0, &near, st);
-        let on = decompose_object(Surface::new(&mesh), &o, budget, budget, &near, st);
+        let none = Effort {
+            rebalance: 0,
+            polish: 0,
+        };
+        let full = Effort::full(budget);
+        let off = decompose_object(Surface::new(&mesh), &o, budget, none, &near, st);
+        let on = decompose_object(Surface::new(&mesh), &o, budget, full, &near, st);
         assert!(
             on.report.rebalance_rounds > 0,
             "{strategy:?}: nothing rebalanced"
@@ -442,7 +449,7 @@ fn rebalancing_next_to_a_neighbour_keeps_the_patches_it_may_touch() {
         // The floor under the ball and the foot on the ground at least.
         assert!(kept >= 2, "{strategy:?}: {kept} pinned patches");
         // Unpinned, the same bowl's rebalancing changes some of those patches.
-        let free = decompose_object(Surface::new(&mesh), &o, budget, budget, &[], st);
+        let free = decompose_object(Surface::new(&mesh), &o, budget, full, &[], st);
         let changed = off
             .parts
             .iter()
@@ -455,8 +462,8 @@ fn rebalancing_next_to_a_neighbour_keeps_the_patches_it_may_touch() {
             })
             .count();
         eprintln!(
-            "{strategy:?}: rounds {} pinned {kept}, changed when unpinned {changed} ({} rounds)",
-            on.report.rebalance_rounds, free.report.rebalance_rounds
+            "{strategy:?}: rounds {} + {} polished, pinned {kept}, changed when unpinned {changed} ({} rounds)",
+            on.report.rebalance_rounds, on.report.polish_rounds, free.report.rebalance_rounds
         );
         assert!(changed > 0, "{strategy:?}: the pin protected nothing");
     }
@@ -517,9 +524,10 @@ fn top_down_plane_cuts_win_alone_on_level_featured_containers() {
     for (name, mesh, ratio) in &cases {
         let b = o.max_hulls;
         let hulls = |x: &Obj| x.parts.iter().map(|p| p.hull.clone()).collect::<Vec<_>>();
-        let patches = hulls(&decompose_alone(mesh, &o, b, b, &[Strategy::Patches]));
-        let planes = hulls(&decompose_alone(mesh, &o, b, b, &[Strategy::Planes]));
-        let both = decompose_alone(mesh, &o, b, b, &Strategy::ALL);
+        let e = Effort::full(b);
+        let patches = hulls(&decompose_alone(mesh, &o, b, e, &[Strategy::Patches]));
+        let planes = hulls(&decompose_alone(mesh, &o, b, e, &[Strategy::Planes]));
+        let both = decompose_alone(mesh, &o, b, e, &Strategy::ALL);
         assert_limits(&planes, &o);
         let (q_patches, q_planes) = (
             metrics::measure(mesh, &patches),
@@ -575,9 +583,12 @@ fn polishing_lowers_the_95th_percentile_alone() {
     }
     let b = o.max_hulls;
     for (name, mesh, ratio) in &cases {
-        let far = unpinned(mesh);
-        let off = decompose_object(Surface::new(mesh), &o, b, b, &far, &Strategy::ALL);
-        let on = decompose_alone(mesh, &o, b, b, &Strategy::ALL);
+        let rebalanced = Effort {
+            rebalance: b,
+            polish: 0,
+        };
+        let off = decompose_alone(mesh, &o, b, rebalanced, &Strategy::ALL);
+        let on = decompose_alone(mesh, &o, b, Effort::full(b), &Strategy::ALL);
         let hulls = |x: &Obj| x.parts.iter().map(|p| p.hull.clone()).collect::<Vec<_>>();
         let (h_off, h_on) = (hulls(&off), hulls(&on));
         assert_limits(&h_on, &o);
@@ -607,5 +618,73 @@ fn polishing_lowers_the_95th_percentile_alone() {
         } else {
             assert!(on.report.polish_rounds > 0, "{name}");
         }
+    }
+}
+
+/// Next to a neighbour the polishing works on the patches out of its reach (and the ground's):
+/// the bottle standing in the lunch box (shared scene 00009), decomposed at the scene's budget
+/// with its pins, comes out closer at the 95th percentile than rebalanced only (measured
+/// 5.10 → 4.73 % of the diagonal in the whole scene), on 20,000 independent samples, and keeps
+/// every pinned patch as the quality loop made it.
+#[test]
+fn polishing_next_to_a_neighbour_lowers_the_95th_percentile() {
+    let Some(sh) = shared() else {
+        eprintln!("shared datasets not present: skipped");
+        return;
+    };
+    let o = opts();
+    let meshes = world_meshes(&sh.join("datasets/scenes/household/00009_bottle_lunchbox"));
+    let ground = meshes
+        .iter()
+        .filter_map(|m| m.aabb())
+        .map(|b| b.min.z)
+        .fold(f64::INFINITY, f64::min);
+    let (bottle, lunchbox) = (&meshes[1], &meshes[0]);
+    let s = Surface::new(bottle).unwrap();
+    let nb = Surface::new(lunchbox).unwrap();
+    let near = contact_distances(&s, ground, &[&nb], &o);
+    let b = o.max_hulls - o.max_hulls / 8;
+    let rebalanced = Effort {
+        rebalance: b,
+        polish: 0,
+    };
+    let st = &[Strategy::Patches];
+    let off = decompose_object(Surface::new(bottle), &o, b, rebalanced, &near, st);
+    let on = decompose_object(Surface::new(bottle), &o, b, Effort::full(b), &near, st);
+    let hulls = |x: &Obj| x.parts.iter().map(|p| p.hull.clone()).collect::<Vec<_>>();
+    let (h_off, h_on) = (hulls(&off), hulls(&on));
+    assert_limits(&h_on, &o);
+    assert_eq!(h_on.len(), h_off.len(), "same budget");
+    let (q_off, q_on) = (
+        metrics::measure(bottle, &h_off),
+        metrics::measure(bottle, &h_on),
+    );
+    eprintln!(
+        "bottle: p95 {:.3} % -> {:.3} % ({} moves)",
+        q_off.dist_p95 * 100.0,
+        q_on.dist_p95 * 100.0,
+        on.report.polish_rounds
+    );
+    assert!(on.report.polish_rounds > 0);
+    assert!(
+        q_on.dist_p95 <= 0.95 * q_off.dist_p95,
+        "{} -> {}",
+        q_off.dist_p95,
+        q_on.dist_p95
+    );
+    let p = on.params.unwrap();
+    let pinned: Vec<&Part> = on
+        .parts
+        .iter()
+        .filter(|q| rebalance::pinned(&near, &q.tris, q.dev, &p, &o))
+        .collect();
+    assert!(!pinned.is_empty(), "the bottle's foot at least");
+    for q in pinned {
+        assert!(
+            off.parts
+                .iter()
+                .any(|f| f.tris == q.tris && f.hull == q.hull),
+            "a pinned patch changed"
+        );
     }
 }
