@@ -76,14 +76,17 @@ pub fn stats(d: &[f64]) -> (f64, f64, f64) {
 }
 
 /// Distances (relative to the diagonal) from about `n` points on the boundary of the union of
-/// the hulls to the mesh surface.
+/// the hulls to the mesh surface. A point within 1e-6 of the diagonal of another hull is on a
+/// seam between two hulls, inside the union: CoACD cuts a solid into pieces that meet on their
+/// cut planes, and with 1e-9 rounding left its YCB pear's inner cut faces on the boundary
+/// (p95 5.87 % of the diagonal, 1.80 % as seams).
 pub fn surface_distances(s: &Surface, hulls: &[Hull], n: usize) -> Vec<f64> {
     let areas: Vec<f64> = hulls.iter().map(|h| h.mesh().area()).collect();
     let total: f64 = areas.iter().sum();
     if !(total > 0.0) {
         return Vec::new();
     }
-    let eps = 1e-9 * s.diag;
+    let eps = 1e-6 * s.diag;
     hulls
         .par_iter()
         .enumerate()
