@@ -94,6 +94,21 @@ impl Surface {
                 .is_inside
     }
 
+    /// Generalised winding number of the surface about `p` (the solid angle its triangles
+    /// subtend, over 4π): 1 inside a closed outward mesh, 0 outside, and close to that for a
+    /// mesh with small holes, which [`Surface::contains`] cannot tell.
+    pub fn winding_number(&self, p: &P3) -> f64 {
+        let mut w = 0.0;
+        for t in 0..self.mesh.triangles.len() {
+            let [a, b, c] = self.mesh.triangle(t).map(|q| q - p);
+            let (la, lb, lc) = (a.norm(), b.norm(), c.norm());
+            let num = a.dot(&b.cross(&c));
+            let den = la * lb * lc + a.dot(&b) * lc + b.dot(&c) * la + c.dot(&a) * lb;
+            w += 2.0 * num.atan2(den);
+        }
+        w / (4.0 * std::f64::consts::PI)
+    }
+
     /// Distance along a ray from `p` in direction `dir` (unit) to the first surface hit within
     /// `max`; `None` when nothing is hit.
     pub fn ray(&self, p: &P3, dir: &V3, max: f64) -> Option<f64> {
@@ -531,8 +546,8 @@ pub fn ray_frames(s: &Surface) -> Vec<[V3; 3]> {
 /// The surface as seen from `c`, inside it: along each of `n` directions (spread over the
 /// ellipsoid of semi-axes `axes`, see [`ray_frames`]), the first point where a ray from `c`
 /// leaves the mesh, triangulated as the directions are. A polyhedron star-shaped about `c` by
-/// construction, whose vertices lie on the mesh. `None` when a ray finds no surface (`c`
-/// outside or the mesh open).
+/// construction, whose vertices lie on the mesh (or, through a hole, on its convex hull).
+/// `None` when more than 2 % of the rays find no surface (`c` outside or the mesh open wide).
 pub fn radial_mesh(
     s: &Surface,
     c: &P3,
@@ -541,9 +556,25 @@ pub fn radial_mesh(
 ) -> Option<(Vec<P3>, Vec<[u32; 3]>)> {
     let (dirs, tris) = sphere_directions(n, axes)?;
     let far = 2.0 * s.diag;
+    let hits: Vec<Option<f64>> = dirs.par_iter().map(|u| s.ray(c, u, far)).collect();
+    // A ray through a hole (scans have small ones) stops where it leaves the mesh's convex
+    // hull instead; more than 2 % of them: the mesh is open wide.
+    let misses = hits.iter().filter(|t| t.is_none()).count();
+    if misses * 50 > hits.len() {
+        return None;
+    }
+    let full = if misses > 0 {
+        Some(Hull::from_points(&s.mesh.vertices)?)
+    } else {
+        None
+    };
     let pts: Option<Vec<P3>> = dirs
-        .par_iter()
-        .map(|u| s.ray(c, u, far).map(|t| c + u * t))
+        .iter()
+        .zip(&hits)
+        .map(|(u, t)| {
+            let t = t.or_else(|| full.as_ref().map(|h| depth_under(h, c, &(c + u)) + 1.0))?;
+            Some(c + u * t)
+        })
         .collect();
     Some((pts?, tris))
 }
