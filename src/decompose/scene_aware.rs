@@ -383,6 +383,21 @@ struct Part {
     dev: f64,
 }
 
+impl Part {
+    /// A piece of a whole object (the shortcut, cone, star or V-HACD pieces): no triangles of
+    /// its own, no cuts.
+    fn piece(hull: Hull, outer: Vec<P3>, normal: V3, dev: f64) -> Part {
+        Part {
+            tris: Vec::new(),
+            hull,
+            outer,
+            normal,
+            cuts: Vec::new(),
+            dev,
+        }
+    }
+}
+
 struct Obj {
     surf: Option<Surface>,
     feat: Option<patches::Features>,
@@ -583,14 +598,8 @@ fn shortcut(s: &Surface, p: &Params, opts: &DecomposeOptions, budget: usize) -> 
     for h in candidates.into_iter().flatten().map(inflate) {
         let (p95, max) = deviation(&h)?;
         if p95 <= p.tol && max <= 3.0 * p.tol {
-            return Some(vec![Part {
-                tris: Vec::new(),
-                outer: h.vertices.clone(),
-                hull: h,
-                normal: V3::zeros(),
-                cuts: Vec::new(),
-                dev: max,
-            }]);
+            let outer = h.vertices.clone();
+            return Some(vec![Part::piece(h, outer, V3::zeros(), max)]);
         }
     }
     // Convex but too round for one hull: cone pieces of the full hull, or of a greedy
@@ -615,14 +624,7 @@ fn shortcut(s: &Surface, p: &Params, opts: &DecomposeOptions, budget: usize) -> 
             return Some(
                 pieces
                     .into_iter()
-                    .map(|(hull, outer, normal)| Part {
-                        tris: Vec::new(),
-                        hull,
-                        outer,
-                        normal,
-                        cuts: Vec::new(),
-                        dev: max,
-                    })
+                    .map(|(hull, outer, normal)| Part::piece(hull, outer, normal, max))
                     .collect(),
             );
         }
@@ -707,14 +709,7 @@ fn star(
     let dev = max * s.diag;
     let parts = pieces
         .into_iter()
-        .map(|(hull, outer, normal)| Part {
-            tris: Vec::new(),
-            hull,
-            outer,
-            normal,
-            cuts: Vec::new(),
-            dev,
-        })
+        .map(|(hull, outer, normal)| Part::piece(hull, outer, normal, dev))
         .collect();
     Some((p95, parts))
 }
@@ -781,13 +776,9 @@ fn voxel_parts(s: &Surface, opts: &DecomposeOptions, budget: usize) -> Option<(f
     let (_, p95, max) = metrics::stats(&d);
     let parts = hulls
         .into_iter()
-        .map(|hull| Part {
-            tris: Vec::new(),
-            outer: hull.vertices.clone(),
-            hull,
-            normal: V3::zeros(),
-            cuts: Vec::new(),
-            dev: max * s.diag,
+        .map(|hull| {
+            let outer = hull.vertices.clone();
+            Part::piece(hull, outer, V3::zeros(), max * s.diag)
         })
         .collect();
     Some((p95, parts))
