@@ -640,9 +640,10 @@ fn shortcut(s: &Surface, p: &Params, opts: &DecomposeOptions, budget: usize) -> 
 /// inner faces, the chords of round patches, lie inside it: the YCB apple's 32 patches kept
 /// 24 % of its volume, their boundary 3.4 % of the diagonal from its surface at the 95th
 /// percentile where its single convex hull is 1.25 %. `None` for a centre outside (by the
-/// winding number), a ray that meets no surface (a mesh open wide), or when the mesh is not within reach of the pieces (not star-shaped about its
-/// centre: more than 1 % of its surface beyond the tolerance outside them). Returns them with
-/// their [`p95_distance`].
+/// winding number), more than 2 % of the rays meeting no surface (a mesh open wide), or when
+/// the mesh is not within reach of the pieces (not star-shaped about its centre: more than
+/// 1 % of its surface beyond the tolerance outside them). Returns them with their
+/// [`distance_stats`] 95th percentile.
 fn star(
     s: &Surface,
     p: &Params,
@@ -674,11 +675,8 @@ fn star(
     // seen, or more (×1.5 each time) when that takes more pieces than the budget.
     let cap = opts.max_vertices.checked_sub(1)?;
     let n = budget * cap / 2;
-    let tris: Vec<[P3; 3]> = (0..s.mesh.triangles.len())
-        .map(|i| s.mesh.triangle(i))
-        .collect();
-    let probes = geom::sample_triangles(&tris, 2000, 0x57a2);
-    let (d, pieces) = geom::ray_frames(s)
+    let probes = s.samples(2000, 0x57a2);
+    let best = geom::ray_frames(s)
         .par_iter()
         .filter_map(|axes| {
             let (v, t) = geom::radial_mesh(s, &c, n, axes)?;
@@ -698,14 +696,14 @@ fn star(
             if out as f64 > 0.01 * probes.len() as f64 {
                 return None;
             }
-            let d = metrics::surface_distances(s, &hulls, P95_SAMPLES);
-            (!d.is_empty()).then_some((d, pieces))
+            let (p95, max) = distance_stats(s, &hulls)?;
+            Some((p95, max, pieces))
         })
         .collect::<Vec<_>>()
         .into_iter()
-        .min_by(|a, b| metrics::stats(&a.0).1.total_cmp(&metrics::stats(&b.0).1))?;
-    // `d` is relative to the diagonal; a part's `dev` is a length.
-    let (_, p95, max) = metrics::stats(&d);
+        .min_by(|a, b| a.0.total_cmp(&b.0))?;
+    // `max` is relative to the diagonal; a part's `dev` is a length.
+    let (p95, max, pieces) = best;
     let dev = max * s.diag;
     let parts = pieces
         .into_iter()
@@ -762,18 +760,14 @@ fn thick_solid(s: &Surface) -> bool {
 /// limits and `budget`) as parts, for a solid that the patches left hollow and its centre does
 /// not see whole (a curved banana): the YCB banana's 32 patches kept 36 % of its volume at p95
 /// 1.64 % of the diagonal, V-HACD's 11 hulls 99 % at 0.25 %. Returns them with their
-/// [`p95_distance`].
+/// [`distance_stats`] 95th percentile.
 fn voxel_parts(s: &Surface, opts: &DecomposeOptions, budget: usize) -> Option<(f64, Vec<Part>)> {
     let o = DecomposeOptions {
         max_hulls: budget,
         ..opts.clone()
     };
     let hulls = super::vhacd::decompose_one(&s.mesh, &o);
-    let d = metrics::surface_distances(s, &hulls, P95_SAMPLES);
-    if d.is_empty() {
-        return None;
-    }
-    let (_, p95, max) = metrics::stats(&d);
+    let (p95, max) = distance_stats(s, &hulls)?;
     let parts = hulls
         .into_iter()
         .map(|hull| {
@@ -788,8 +782,7 @@ fn voxel_parts(s: &Surface, opts: &DecomposeOptions, budget: usize) -> Option<(f
 /// coarse grid): surface patches on a solid, a shell with the inside hollow.
 fn hollow(s: &Surface, parts: &[Part]) -> bool {
     let vol = s.mesh.signed_volume().abs();
-    let hulls: Vec<Hull> = parts.iter().map(|q| q.hull.clone()).collect();
-    vol > 0.0 && metrics::union_volume(&hulls, 48) < 0.5 * vol
+    vol > 0.0 && metrics::union_volume(&hulls_of(parts), 48) < 0.5 * vol
 }
 
 /// The closed, convex connected components of a mesh of several (a shelf built of boards, a
@@ -927,16 +920,11 @@ fn split_candidates(
     }
     // PCA of the area-weighted mid-wall positions.
     let w: f64 = part.tris.iter().map(|&t| s.tri_area[t as usize]).sum();
-    if w > 0.0 {
-        let mean = part.tris.iter().fold(V3::zeros(), |a, &t| {
-            a + f.pos[t as usize].coords * s.tri_area[t as usize]
-        }) / w;
-        let mut cov = nalgebra::Matrix3::zeros();
-        for &t in &part.tris {
-            let d = f.pos[t as usize].coords - mean;
-            cov += d * d.transpose() * s.tri_area[t as usize];
-        }
-        let eig = nalgebra::SymmetricEigen::new(cov);
+    let mid_wall = part
+        .tris
+        .iter()
+        .map(|&t| (f.pos[t as usize], s.tri_area[t as usize]));
+    if let Some(eig) = geom::principal_axes(mid_wall) {
         let mut order = [0usize, 1, 2];
         order.sort_by(|&a, &b| {
             eig.eigenvalues[b]
@@ -1111,22 +1099,22 @@ fn decompose_object(
         strategies
     };
     // Closest at the 95th percentile; ties keep the earlier strategy.
-    let (parts, mut report, p) = strategies
+    let measured = |st: Strategy| {
+        let r = run(st);
+        (distance_stats(s, &hulls_of(&r.0)), r)
+    };
+    let p95 = |d: &Option<(f64, f64)>| d.map_or(f64::INFINITY, |x| x.0);
+    let (dist, (parts, mut report, p)) = strategies
         .par_iter()
-        .map(|&st| {
-            let r = run(st);
-            (p95_distance(s, &r.0), r)
-        })
+        .map(|&st| measured(st))
         .collect::<Vec<_>>()
         .into_iter()
-        .reduce(|a, b| if b.0 < a.0 { b } else { a })
-        .map(|x| x.1)
-        .unwrap_or_else(|| run(Strategy::Patches));
+        .reduce(|a, b| if p95(&b.0) < p95(&a.0) { b } else { a })
+        .unwrap_or_else(|| measured(Strategy::Patches));
     report.top_down = p.strategy == Strategy::Planes;
     // A whole-solid candidate instead when it lies closer at the 95th percentile. A solid the
     // thickness test missed shows as patches that leave it hollow: V-HACD then too.
-    let hulls: Vec<Hull> = parts.iter().map(|q| q.hull.clone()).collect();
-    let (_, d_parts, reach) = metrics::stats(&metrics::surface_distances(s, &hulls, P95_SAMPLES));
+    let (d_parts, reach) = dist.unwrap_or((0.0, 0.0));
     if !thick && d_parts > opts.tolerance && hollow(s, &parts) {
         whole.extend(voxel_parts(s, opts, budget).map(|(d, q)| (d, q, Solid::Voxel)));
     }
@@ -1145,16 +1133,21 @@ fn decompose_object(
     }
 }
 
-/// 95th percentile of the sampled distance from the parts' union boundary to the surface,
-/// relative to the diagonal: what
-/// [`decompose_object`] chooses a strategy by (the bench's measure, on fewer samples).
-fn p95_distance(s: &Surface, parts: &[Part]) -> f64 {
-    let hulls: Vec<Hull> = parts.iter().map(|q| q.hull.clone()).collect();
-    let d = metrics::surface_distances(s, &hulls, P95_SAMPLES);
+/// 95th percentile and maximum of the sampled distance from the union boundary of `hulls` to
+/// the surface, relative to the diagonal: what [`decompose_object`] chooses by (the bench's
+/// measure, on fewer samples). `None` without hull surface.
+fn distance_stats(s: &Surface, hulls: &[Hull]) -> Option<(f64, f64)> {
+    let d = metrics::surface_distances(s, hulls, P95_SAMPLES);
     if d.is_empty() {
-        return f64::INFINITY;
+        return None;
     }
-    metrics::stats(&d).1
+    let (_, p95, max) = metrics::stats(&d);
+    Some((p95, max))
+}
+
+/// The hulls of `parts`.
+fn hulls_of(parts: &[Part]) -> Vec<Hull> {
+    parts.iter().map(|q| q.hull.clone()).collect()
 }
 
 const P95_SAMPLES: usize = 4000;

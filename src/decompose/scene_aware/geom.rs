@@ -127,6 +127,16 @@ impl Surface {
     }
 }
 
+impl Surface {
+    /// `n` points on the whole surface, stratified by area (see [`sample_triangles`]).
+    pub fn samples(&self, n: usize, seed: u64) -> Vec<P3> {
+        let tris: Vec<[P3; 3]> = (0..self.mesh.triangles.len())
+            .map(|i| self.mesh.triangle(i))
+            .collect();
+        sample_triangles(&tris, n, seed)
+    }
+}
+
 /// `n` points on a triangle set, stratified by area (deterministic for a given `seed`).
 pub fn sample_triangles(tris: &[[P3; 3]], n: usize, seed: u64) -> Vec<P3> {
     let areas: Vec<f64> = tris.iter().map(triangle_area).collect();
@@ -522,25 +532,35 @@ pub fn ray_frames(s: &Surface) -> Vec<[V3; 3]> {
         e * ((hi - lo) / 2.0).max(1e-6 * s.diag)
     };
     let mut frames = vec![[V3::x(), V3::y(), V3::z()].map(|e| extent(&e))];
-    let w: f64 = s.tri_area.iter().sum();
-    if w > 0.0 {
-        let mean = s
-            .tri_centroid
-            .iter()
-            .zip(&s.tri_area)
-            .fold(V3::zeros(), |m, (q, a)| m + q.coords * *a)
-            / w;
-        let mut cov = nalgebra::Matrix3::zeros();
-        for (q, a) in s.tri_centroid.iter().zip(&s.tri_area) {
-            let d = q.coords - mean;
-            cov += d * d.transpose() * *a;
-        }
-        let eig = nalgebra::SymmetricEigen::new(cov);
+    let centroids = s
+        .tri_centroid
+        .iter()
+        .copied()
+        .zip(s.tri_area.iter().copied());
+    if let Some(eig) = principal_axes(centroids) {
         frames.push(std::array::from_fn(|k| {
             extent(&eig.eigenvectors.column(k).into_owned())
         }));
     }
     frames
+}
+
+/// Principal axes of weighted points: the eigen-decomposition of their weighted covariance
+/// about their weighted mean; `None` when the weights add up to nothing.
+pub fn principal_axes(
+    pts: impl Iterator<Item = (P3, f64)> + Clone,
+) -> Option<nalgebra::SymmetricEigen<f64, nalgebra::U3>> {
+    let w: f64 = pts.clone().map(|(_, a)| a).sum();
+    if !(w > 0.0) {
+        return None;
+    }
+    let mean = pts.clone().fold(V3::zeros(), |m, (q, a)| m + q.coords * a) / w;
+    let mut cov = nalgebra::Matrix3::zeros();
+    for (q, a) in pts {
+        let d = q.coords - mean;
+        cov += d * d.transpose() * a;
+    }
+    Some(nalgebra::SymmetricEigen::new(cov))
 }
 
 /// The surface as seen from `c`, inside it: along each of `n` directions (spread over the

@@ -12,7 +12,7 @@
 //! * **Cavity kept**: for containers (see [`cavity_probe`]), whether the probe point in the
 //!   cavity is outside every hull.
 
-use super::geom::{sample_hull, sample_triangles, Surface};
+use super::geom::{sample_hull, Surface};
 use crate::decompose::Hull;
 use crate::mesh::{Aabb, Mesh, P3, V3};
 use rayon::prelude::*;
@@ -145,10 +145,7 @@ pub fn union_volume(hulls: &[Hull], res: usize) -> f64 {
 
 /// Fraction of the mesh surface (sampled) not within 0.1 % of the diagonal of some hull.
 pub fn uncovered(s: &Surface, hulls: &[Hull], n: usize) -> f64 {
-    let tris: Vec<[P3; 3]> = (0..s.mesh.triangles.len())
-        .map(|i| s.mesh.triangle(i))
-        .collect();
-    let pts = sample_triangles(&tris, n, 0xc0e);
+    let pts = s.samples(n, 0xc0e);
     if pts.is_empty() {
         return 0.0;
     }
