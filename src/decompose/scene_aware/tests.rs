@@ -245,13 +245,14 @@ fn real_scenes_hulls_apart() {
         eprintln!("shared datasets not present: skipped");
         return;
     };
-    // 00008: the polishing next to a neighbour moves patches; 00009: V-HACD's hulls for both.
+    // 00008: the polishing next to a neighbour moves patches; 00009: V-HACD's hulls for the
+    // bottle, not for the lunch box it stands on.
     for s in [
         "food/00001_lemon_bowl",
         "toys/00007_ball_mug",
         "kitchenware/00008_spoon_mug",
         "household/00009_bottle_lunchbox",
-        // Star pieces: the apple and the plum in the bowl; V-HACD: a sneaker.
+        // Star pieces: the apple and the plum in the bowl; shoes resting on one another.
         "food/00002_fruit_bowl",
         "apparel/00005_shoes_tray",
     ] {
