@@ -413,11 +413,14 @@ const DEV_SAMPLES: usize = 64;
 /// among `on_mesh` (mesh vertices the hull was built from) are at distance 0 and not queried:
 /// a third of the queries of a decomposition on the GSO mug.
 fn deviation(s: &Surface, h: &Hull, seed: u64, on_mesh: &[P3]) -> f64 {
-    geom::sample_hull(h, DEV_SAMPLES, seed)
-        .iter()
-        .chain(h.vertices.iter().filter(|v| !on_mesh.contains(v)))
-        .map(|p| s.distance(p))
-        .fold(0.0, f64::max)
+    let samples = geom::sample_hull(h, DEV_SAMPLES, seed);
+    // The vertices first: pushed into the material or cut, they are the likeliest to be far.
+    s.max_distance(
+        h.vertices
+            .iter()
+            .filter(|v| !on_mesh.contains(v))
+            .chain(&samples),
+    )
 }
 
 /// Build the hull of a patch (with earlier cuts applied). A patch holding both sides of a wall

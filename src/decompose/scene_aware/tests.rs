@@ -767,3 +767,38 @@ fn real_solids_are_filled_star_pieces_for_an_apple_voxels_for_a_banana() {
     assert!(q.dist_p95 <= 0.005, "{q:?}");
     assert!(q.volume_ratio >= 0.9, "{q:?}");
 }
+
+#[test]
+fn surface_distance_queries_agree_with_parry() {
+    // The engine's own point-to-mesh queries against parry's `project_point` (an independent
+    // implementation): on the bowl, at points from inside the wall to 10 % of the diagonal out.
+    use parry3d_f64::query::PointQuery;
+    let s = geom::Surface::new(&bowl()).expect("surface");
+    let mut rng = crate::rng::Rng::new(7);
+    let (lo, hi) = (s.aabb.min, s.aabb.max);
+    let pts: Vec<P3> = (0..2000)
+        .map(|_| {
+            let f = |a: f64, b: f64, u: f64| a + (b - a) * (1.2 * u - 0.1);
+            P3::new(
+                f(lo.x, hi.x, rng.next_f64()),
+                f(lo.y, hi.y, rng.next_f64()),
+                f(lo.z, hi.z, rng.next_f64()),
+            )
+        })
+        .collect();
+    let mut all = Vec::new();
+    for p in &pts {
+        let q = Vector::new(p.x, p.y, p.z);
+        let want = (s.tri.project_point(&Pose::identity(), q, false).point - q).length();
+        let got = s.distance(p);
+        assert!((got - want).abs() <= 1e-12 * s.diag, "{got} vs {want} at {p:?}");
+        // `within` is exactly `distance <= r`, on either side of the distance.
+        assert!(s.within(p, got) && s.within(p, got * 1.001 + 1e-12));
+        assert!(got == 0.0 || !s.within(p, got * 0.999));
+        all.push(got);
+    }
+    let max = all.iter().copied().fold(0.0, f64::max);
+    assert!(max > 0.05 * s.diag, "points reach out: {max}");
+    assert_eq!(s.max_distance(&pts), max);
+    assert_eq!(s.max_distance(pts.iter().rev()), max);
+}
