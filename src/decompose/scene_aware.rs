@@ -1097,21 +1097,24 @@ fn decompose_object(
     // Whole-solid candidates: star pieces (a solid seen from its centre) and, for a thick
     // solid, V-HACD's hulls. The closer one within the tolerance is kept as it is; else they
     // compete with the patches below (ties keep the earlier).
+    // Built side by side: on the GSO bottle V-HACD takes 0.26 s and the star pieces 0.15 s.
     let mut whole: Vec<(f64, Vec<Part>, Solid)> = Vec::new();
     let supports = |q: &Vec<Part>| keeps_support(s, &p, opts, near, q);
+    let thick = thick_solid(s);
+    let (stars, voxels) = rayon::join(
+        || star(s, &p, opts, budget),
+        || thick.then(|| voxel_parts(s, opts, budget)).flatten(),
+    );
     whole.extend(
-        star(s, &p, opts, budget)
+        stars
             .filter(|(_, q)| supports(q))
             .map(|(d, q)| (d, q, Solid::Star)),
     );
-    let thick = thick_solid(s);
-    if thick {
-        whole.extend(
-            voxel_parts(s, opts, budget)
-                .filter(|(_, q)| supports(q))
-                .map(|(d, q)| (d, q, Solid::Voxel)),
-        );
-    }
+    whole.extend(
+        voxels
+            .filter(|(_, q)| supports(q))
+            .map(|(d, q)| (d, q, Solid::Voxel)),
+    );
     // The closest whose hulls reach at most `bound` past the surface anywhere: V-HACD's hulls
     // of the YCB pear were closer than its star pieces at the 95th percentile (0.47 against
     // 0.49 % of the diagonal) but one reached 7.1 % past it. Alone within the tolerance, 5
