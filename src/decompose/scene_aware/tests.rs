@@ -791,7 +791,10 @@ fn surface_distance_queries_agree_with_parry() {
         let q = Vector::new(p.x, p.y, p.z);
         let want = (s.tri.project_point(&Pose::identity(), q, false).point - q).length();
         let got = s.distance(p);
-        assert!((got - want).abs() <= 1e-12 * s.diag, "{got} vs {want} at {p:?}");
+        assert!(
+            (got - want).abs() <= 1e-12 * s.diag,
+            "{got} vs {want} at {p:?}"
+        );
         // `within` is exactly `distance <= r`, on either side of the distance.
         assert!(s.within(p, got) && s.within(p, got * 1.001 + 1e-12));
         assert!(got == 0.0 || !s.within(p, got * 0.999));
