@@ -6,7 +6,7 @@ use crate::decompose::Hull;
 use crate::mesh::{to_dvec, triangle_area, Aabb, Mesh, P3, V3};
 use crate::rng::Rng;
 use parry3d_f64::math::{Pose, Vector};
-use parry3d_f64::partitioning::{BvhLeafCost, BvhNode, TraversalAction};
+use parry3d_f64::partitioning::{BvhNode, TraversalAction};
 use parry3d_f64::query::{PointQuery, Ray, RayCast};
 use parry3d_f64::shape::{ConvexPolyhedron, TriMesh, TriMeshFlags};
 use rayon::prelude::*;
@@ -16,7 +16,7 @@ pub struct Surface {
     /// The mesh (winding flipped when it enclosed a negative volume, so normals face out).
     pub mesh: Mesh,
     pub tri: TriMesh,
-    /// The corners of `tri`'s triangles, by its BVH's leaf index (see [`Surface::distance`]).
+    /// The corners of `tri`'s triangles, by its BVH's leaf index (see [`Surface::within`]).
     corners: Vec<[Vector; 3]>,
     /// Watertight and consistently oriented: inside tests are meaningful.
     pub closed: bool,
@@ -88,39 +88,30 @@ impl Surface {
         })
     }
 
-    /// Unsigned distance from `p` to the surface: a best-first descent of the BVH of `tri`
-    /// with squared distances to its triangles (see [`point_triangle_dist2`]), 25 % faster on
-    /// the GSO mug scan than parry's `project_point`, which also locates the projection.
+    /// Unsigned distance from `p` to the surface (parry's projection).
     pub fn distance(&self, p: &P3) -> f64 {
         let q = to_dvec(p);
-        self.tri
-            .bvh()
-            .find_best(
-                f64::MAX,
-                |node, _| aabb_dist2(node, q),
-                |i, _| {
-                    let [a, b, c] = self.corners[i as usize];
-                    Some(Dist2(point_triangle_dist2(q, a, b, c)))
-                },
-            )
-            .map_or(f64::INFINITY, |(_, d)| d.0.sqrt())
+        let proj = self.tri.project_point(&Pose::identity(), q, false);
+        (proj.point - q).length()
     }
 
-    /// Whether some point of the surface is within `r` of `p`, i.e. `distance(p) <= r` (the
-    /// same test, rounding included): a depth-first descent of the BVH that stops at the
-    /// first triangle found, a third of the cost of a distance query when one is near.
+    /// Whether some point of the surface is within `r` of `p`: a depth-first descent of the
+    /// BVH of `tri` that stops at the first triangle found, with squared distances to the
+    /// triangles ([`point_triangle_dist2`]); a third of the cost of a [`Surface::distance`]
+    /// when one is near. It agrees with `distance(p) <= r` but within rounding (1e-15 of the
+    /// distance), so the tests that must give what `distance` gives ([`Surface::farther`],
+    /// [`Surface::max_distance`]) ask it with a margin.
     pub fn within(&self, p: &P3, r: f64) -> bool {
         let q = to_dvec(p);
-        // Boxes are pruned with a margin, so rounding never hides a triangle at `r`.
-        let prune = r * r * (1.0 + 1e-9);
+        let r2 = r * r;
         let mut found = false;
         self.tri.bvh().traverse(|node| {
-            if aabb_dist2(node, q) > prune {
+            if aabb_dist2(node, q) > r2 {
                 return TraversalAction::Prune;
             }
             if let Some(i) = node.leaf_data() {
                 let [a, b, c] = self.corners[i as usize];
-                if point_triangle_dist2(q, a, b, c).sqrt() <= r {
+                if point_triangle_dist2(q, a, b, c) <= r2 {
                     found = true;
                     return TraversalAction::EarlyExit;
                 }
@@ -130,13 +121,20 @@ impl Surface {
         found
     }
 
-    /// The largest [`Surface::distance`] of `pts`: a point within the largest so far (most of
-    /// them, as they are sampled near the mesh) costs only a [`Surface::within`] test. Pass
-    /// the points likeliest to be far first.
+    /// `distance(p) > r`, exactly, rounding included: a point within `r` less a margin (most
+    /// points, sampled near the mesh) costs only a [`Surface::within`] test. Exactness
+    /// matters: on the symmetric basket fixture, distances off by rounding broke ties between
+    /// mirrored splits the other way, and the fruits rolled out of the basket in Rapier.
+    pub fn farther(&self, p: &P3, r: f64) -> bool {
+        !self.within(p, r * (1.0 - WITHIN_MARGIN)) && self.distance(p) > r
+    }
+
+    /// The largest [`Surface::distance`] of `pts`, exactly: a point within the largest so far
+    /// costs only a [`Surface::within`] test. Pass the points likeliest to be far first.
     pub fn max_distance<'a>(&self, pts: impl IntoIterator<Item = &'a P3>) -> f64 {
         let mut m: f64 = 0.0;
         for p in pts {
-            if !(m > 0.0 && self.within(p, m)) {
+            if !(m > 0.0 && self.within(p, m * (1.0 - WITHIN_MARGIN))) {
                 m = m.max(self.distance(p));
             }
         }
@@ -667,15 +665,9 @@ pub fn radial_mesh(
     Some((pts?, tris))
 }
 
-/// A squared distance, as the cost of a BVH leaf.
-#[derive(Clone, Copy)]
-struct Dist2(f64);
-
-impl BvhLeafCost for Dist2 {
-    fn cost(&self) -> f64 {
-        self.0
-    }
-}
+/// Relative margin by which [`Surface::within`] is asked for a tighter radius where an exact
+/// answer is needed: far above its rounding (1e-15), far below any distance that matters.
+const WITHIN_MARGIN: f64 = 1e-9;
 
 /// Squared distance from `p` to a BVH node's box (0 inside).
 fn aabb_dist2(node: &BvhNode, p: Vector) -> f64 {
@@ -687,8 +679,34 @@ fn aabb_dist2(node: &BvhNode, p: Vector) -> f64 {
 }
 
 /// Squared distance from `p` to the triangle `abc`, by the Voronoi region of its closest
-/// feature (Ericson, *Real-Time Collision Detection*, 5.1.5).
+/// feature (Ericson, *Real-Time Collision Detection*, 5.1.5). A degenerate triangle (scans
+/// have them: two corners at one point, or three in a line) is measured as its three edges.
 pub fn point_triangle_dist2(p: Vector, a: Vector, b: Vector, c: Vector) -> f64 {
+    let d = voronoi_dist2(p, a, b, c);
+    if !d.is_finite() {
+        segment_dist2(p, a, b)
+            .min(segment_dist2(p, b, c))
+            .min(segment_dist2(p, c, a))
+    } else {
+        d
+    }
+}
+
+/// Squared distance from `p` to the segment `ab` (a point when `a == b`).
+fn segment_dist2(p: Vector, a: Vector, b: Vector) -> f64 {
+    let ab = b - a;
+    let l2 = ab.length_squared();
+    let t = if l2 > 0.0 {
+        ((p - a).dot(ab) / l2).clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    (p - (a + ab * t)).length_squared()
+}
+
+/// [`point_triangle_dist2`] for a proper triangle; not finite (a zero denominator) for some
+/// degenerate ones.
+fn voronoi_dist2(p: Vector, a: Vector, b: Vector, c: Vector) -> f64 {
     let (ab, ac, ap) = (b - a, c - a, p - a);
     let (d1, d2) = (ab.dot(ap), ac.dot(ap));
     if d1 <= 0.0 && d2 <= 0.0 {

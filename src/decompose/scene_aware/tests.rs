@@ -770,9 +770,9 @@ fn real_solids_are_filled_star_pieces_for_an_apple_voxels_for_a_banana() {
 
 #[test]
 fn surface_distance_queries_agree_with_parry() {
-    // The engine's own point-to-mesh queries against parry's `project_point` (an independent
-    // implementation): on the bowl, at points from inside the wall to 10 % of the diagonal out.
-    use parry3d_f64::query::PointQuery;
+    // The engine's own "any triangle within r" descent against parry's `project_point` (an
+    // independent implementation), and the exact tests built on it: on the bowl, at points
+    // from inside the wall to 10 % of the diagonal out.
     let s = geom::Surface::new(&bowl()).expect("surface");
     let mut rng = crate::rng::Rng::new(7);
     let (lo, hi) = (s.aabb.min, s.aabb.max);
@@ -788,20 +788,46 @@ fn surface_distance_queries_agree_with_parry() {
         .collect();
     let mut all = Vec::new();
     for p in &pts {
-        let q = Vector::new(p.x, p.y, p.z);
-        let want = (s.tri.project_point(&Pose::identity(), q, false).point - q).length();
-        let got = s.distance(p);
-        assert!(
-            (got - want).abs() <= 1e-12 * s.diag,
-            "{got} vs {want} at {p:?}"
-        );
-        // `within` is exactly `distance <= r`, on either side of the distance.
-        assert!(s.within(p, got) && s.within(p, got * 1.001 + 1e-12));
-        assert!(got == 0.0 || !s.within(p, got * 0.999));
-        all.push(got);
+        let d = s.distance(p);
+        assert!(s.within(p, d * (1.0 + 1e-12) + 1e-15));
+        assert!(d == 0.0 || !s.within(p, d * (1.0 - 1e-12)));
+        // `farther` is exactly `distance > r`, ties included.
+        for r in [d, d * (1.0 - 1e-6), d * (1.0 + 1e-6), 0.01 * s.diag] {
+            assert_eq!(s.farther(p, r), d > r, "r {r} d {d}");
+        }
+        all.push(d);
     }
     let max = all.iter().copied().fold(0.0, f64::max);
     assert!(max > 0.05 * s.diag, "points reach out: {max}");
     assert_eq!(s.max_distance(&pts), max);
     assert_eq!(s.max_distance(pts.iter().rev()), max);
+}
+
+#[test]
+fn point_triangle_distance_of_degenerate_triangles_is_that_of_their_edges() {
+    // Two corners at one point: the triangle is the segment from (0,0,0) to (1,0,0).
+    let (o, x) = (Vector::new(0.0, 0.0, 0.0), Vector::new(1.0, 0.0, 0.0));
+    let p = Vector::new(0.5, 2.0, 0.0);
+    assert_eq!(geom::point_triangle_dist2(p, o, o, x), 4.0);
+    assert_eq!(geom::point_triangle_dist2(p, o, x, x), 4.0);
+    // Three corners in a line, the middle one between: beyond the end, the distance to it.
+    let m = Vector::new(0.25, 0.0, 0.0);
+    let q = Vector::new(3.0, 0.0, 4.0);
+    assert!((geom::point_triangle_dist2(q, o, m, x) - 20.0).abs() < 1e-12);
+    // All three at one point.
+    assert_eq!(geom::point_triangle_dist2(p, x, x, x), 0.25 + 4.0);
+    // A proper triangle, against the analytic distance to its plane and its edges.
+    let (a, b, c) = (o, Vector::new(2.0, 0.0, 0.0), Vector::new(0.0, 2.0, 0.0));
+    assert_eq!(
+        geom::point_triangle_dist2(Vector::new(0.5, 0.5, 3.0), a, b, c),
+        9.0
+    );
+    assert_eq!(
+        geom::point_triangle_dist2(Vector::new(1.0, -2.0, 0.0), a, b, c),
+        4.0
+    );
+    assert_eq!(
+        geom::point_triangle_dist2(Vector::new(2.0, 2.0, 0.0), a, b, c),
+        2.0
+    );
 }
