@@ -14,7 +14,8 @@
 //! CARGO_TARGET_DIR=/work/main/target cargo run --release --example bench_decompose -- [--quick] [--no-python]
 //! ```
 //! `--quick`: three small fixture meshes (CI). `--ref-dir DIR`: keep (and resume) the Python
-//! reference runs in DIR (with `--no-python`: only read its `results.json`). Without the Python packages the reference columns read "n/a".
+//! reference runs in DIR (with `--no-python`: only read its `results.json`). `--repeat N`: our
+//! engine's time is the median of N runs, which must all give the same hulls. Without the Python packages the reference columns read "n/a".
 
 use interact3d::decompose::scene_aware::{metrics, SceneAware};
 use interact3d::decompose::{vhacd, DecomposeOptions, Hull};
@@ -221,6 +222,15 @@ fn main() {
         std::fs::create_dir_all(d).expect("create --ref-dir");
     }
     let tmp: &Path = ref_dir.as_deref().unwrap_or(tmp_dir.path());
+    // `--repeat N`: time our engine N times and report the median (this machine's timings
+    // vary by 10-20 % from run to run); every run must give the same hulls.
+    let repeat: usize = args
+        .iter()
+        .position(|a| a == "--repeat")
+        .and_then(|i| args.get(i + 1))
+        .and_then(|n| n.parse().ok())
+        .unwrap_or(1)
+        .max(1);
     let key = |si: usize, oi: usize| format!("s{si:02}_o{oi:02}");
     let mut py: BTreeMap<String, serde_json::Value> = BTreeMap::new();
     if !no_python {
@@ -288,15 +298,30 @@ fn main() {
         for (oi, (oname, m)) in s.objects.iter().enumerate() {
             let mut runs: Vec<(&'static str, Run)> = Vec::new();
             let engine = SceneAware::new();
-            let t = Instant::now();
-            let ours = engine
-                .run(&[m], &opts)
-                .map(|r| r.0.into_iter().next().unwrap_or_default());
+            let mut times = Vec::with_capacity(repeat);
+            let mut ours = None;
+            for _ in 0..repeat {
+                let t = Instant::now();
+                let r = engine
+                    .run(&[m], &opts)
+                    .map(|r| r.0.into_iter().next().unwrap_or_default())
+                    .ok();
+                times.push(t.elapsed().as_secs_f64());
+                match &ours {
+                    None => ours = Some(r),
+                    Some(first) => assert!(
+                        *first == r,
+                        "{} ({oname}): two runs gave different hulls",
+                        s.name
+                    ),
+                }
+            }
+            times.sort_by(f64::total_cmp);
             runs.push((
                 "scene_aware",
                 Run {
-                    seconds: Some(t.elapsed().as_secs_f64()),
-                    hulls: ours.ok(),
+                    seconds: Some(times[times.len() / 2]),
+                    hulls: ours.flatten(),
                     note: String::new(),
                 },
             ));
