@@ -798,7 +798,8 @@ fn keeps_support(
     if near.is_empty() {
         return true;
     }
-    let reach = opts.clearance + 1.25 * p.tol;
+    // The reach of a hull within the tolerance, as the patches' pins use.
+    let reach = rebalance::reach(0.0, p, opts);
     let eps = 1e-9 * s.diag;
     let support: Vec<u32> = (0..s.mesh.triangles.len() as u32)
         .filter(|&t| near[t as usize] <= reach && s.tri_normal[t as usize].z >= SUPPORT_NZ)

@@ -47,7 +47,7 @@
 use super::geom::{sample_hull, Surface};
 use super::patches::Features;
 use super::rebalance::{adjacency, adjacent_pairs, lift, pinned, union};
-use super::{build_part, metrics, split_candidates, Params, Part, CONTACT_DEV};
+use super::{build_part, hulls_of, metrics, split_candidates, Params, Part, CONTACT_DEV};
 use crate::decompose::{DecomposeOptions, Hull};
 use rayon::prelude::*;
 use std::collections::BTreeMap;
@@ -192,7 +192,7 @@ pub(super) fn polish(
             break;
         }
         let thr = cur.0;
-        let owned: Vec<Hull> = parts.iter().map(|q| q.hull.clone()).collect();
+        let owned: Vec<Hull> = hulls_of(parts);
         let hulls: Vec<&Hull> = owned.iter().collect();
         let ex: Vec<f64> = (0..parts.len())
             .into_par_iter()

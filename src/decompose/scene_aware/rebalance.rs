@@ -186,9 +186,16 @@ pub(super) fn pinned(
     opts: &DecomposeOptions,
 ) -> bool {
     !near.is_empty() && {
-        let reach = opts.clearance + 1.25 * dev.max(p.tol);
+        let reach = reach(dev, p, opts);
         tris.iter().any(|&t| near[t as usize] <= reach)
     }
+}
+
+/// How near the ground or a neighbour (`near`) a triangle of a patch whose hull deviates
+/// `dev` may touch it: the hull may bulge `dev` (at least the tolerance) past the surface, a
+/// quarter more for sampling.
+pub(super) fn reach(dev: f64, p: &Params, opts: &DecomposeOptions) -> f64 {
+    opts.clearance + 1.25 * dev.max(p.tol)
 }
 
 /// How far the hull's surface lies above the patch's up-facing triangles (normal within
