@@ -67,6 +67,15 @@ pub trait Decomposer: Send + Sync {
 /// Bring raw hull point sets within the limits: build hulls, drop degenerate ones, merge down to
 /// `max_hulls` (cheapest merges first), then simplify each to `max_vertices`.
 pub fn finish(raw: Vec<Vec<crate::mesh::P3>>, opts: &DecomposeOptions) -> Vec<Hull> {
+    finish_with(raw, opts, Hull::simplified)
+}
+
+/// [`finish`] with another way (`reduce`) to bring a hull down to `max_vertices`.
+pub fn finish_with(
+    raw: Vec<Vec<crate::mesh::P3>>,
+    opts: &DecomposeOptions,
+    reduce: impl Fn(Hull, usize) -> Option<Hull>,
+) -> Vec<Hull> {
     let mut hulls: Vec<Hull> = raw
         .iter()
         .filter_map(|pts| Hull::from_points(pts))
@@ -75,7 +84,7 @@ pub fn finish(raw: Vec<Vec<crate::mesh::P3>>, opts: &DecomposeOptions) -> Vec<Hu
     merge_down(&mut hulls, opts.max_hulls);
     hulls
         .into_iter()
-        .filter_map(|h| h.simplified(opts.max_vertices))
+        .filter_map(|h| reduce(h, opts.max_vertices))
         .filter(|h| h.thickness() >= opts.min_thickness)
         .collect()
 }

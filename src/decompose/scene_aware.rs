@@ -89,7 +89,7 @@ use std::sync::Mutex;
 /// Engine name, recorded in reports and in the cache key.
 pub const NAME: &str = "scene_aware";
 /// Bumped whenever the output for the same input changes (invalidates the cache).
-pub const VERSION: u32 = 11;
+pub const VERSION: u32 = 12;
 
 /// What happened to one object.
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
@@ -574,27 +574,7 @@ fn shortcut(s: &Surface, p: &Params, opts: &DecomposeOptions, budget: usize) -> 
         let (_, p95, max) = metrics::stats(&d);
         Some((p95, max))
     };
-    // A little of the volume lost to simplification is given back by a uniform scale about the
-    // centroid (keeps faces planar and level), capped at a quarter of the tolerance at the
-    // farthest vertex, so at most 0.25 % of the diagonal of any gap is used up.
-    let inflate = |h: Hull| -> Hull {
-        if h.volume >= full.volume * 0.999 {
-            return h;
-        }
-        let c = P3::from(h.vertices.iter().map(|v| v.coords).sum::<V3>() / h.vertices.len() as f64);
-        let reach = h
-            .vertices
-            .iter()
-            .map(|v| (v - c).norm())
-            .fold(0.0, f64::max);
-        let k = (full.volume / h.volume)
-            .cbrt()
-            .min(1.0 + 0.25 * p.tol / reach.max(1e-300));
-        let pts: Vec<P3> = h.vertices.iter().map(|v| c + (v - c) * k).collect();
-        Hull::from_points(&pts)
-            .filter(|g| g.vertices.len() <= opts.max_vertices)
-            .unwrap_or(h)
-    };
+    let inflate = |h: Hull| inflate(h, full.volume, 0.25 * p.tol, opts.max_vertices);
     let candidates = [
         full.clone().simplified(opts.max_vertices),
         greedy_hull(&full, opts.max_vertices),
@@ -634,6 +614,29 @@ fn shortcut(s: &Surface, p: &Params, opts: &DecomposeOptions, budget: usize) -> 
         }
     }
     None
+}
+
+/// A little of the volume a simplified hull `h` lost (`volume`: the original's) given back by a
+/// uniform scale about its centroid (keeps faces planar and level), capped so that no vertex
+/// moves more than `cap` (a quarter of the tolerance: at most 0.25 % of the diagonal of any
+/// gap is used up).
+fn inflate(h: Hull, volume: f64, cap: f64, max_vertices: usize) -> Hull {
+    if h.volume >= volume * 0.999 {
+        return h;
+    }
+    let c = P3::from(h.vertices.iter().map(|v| v.coords).sum::<V3>() / h.vertices.len() as f64);
+    let reach = h
+        .vertices
+        .iter()
+        .map(|v| (v - c).norm())
+        .fold(0.0, f64::max);
+    let k = (volume / h.volume)
+        .cbrt()
+        .min(1.0 + cap / reach.max(1e-300));
+    let pts: Vec<P3> = h.vertices.iter().map(|v| c + (v - c) * k).collect();
+    Hull::from_points(&pts)
+        .filter(|g| g.vertices.len() <= max_vertices)
+        .unwrap_or(h)
 }
 
 /// Star pieces of a closed object seen from inside (see [`geom::star_pieces`]): the surface
@@ -770,7 +773,16 @@ fn voxel_parts(s: &Surface, opts: &DecomposeOptions, budget: usize) -> Option<(f
         max_hulls: budget,
         ..opts.clone()
     };
-    let hulls = super::vhacd::decompose_one(&s.mesh, &o);
+    // Each cluster's hull is brought to `max_vertices` the way the convex shortcut does it:
+    // the greedy reduction (it keeps the vertices that lose most volume, where parry's engine
+    // spreads them by farthest-point sampling), then inflated back towards the cluster hull's
+    // volume by at most a quarter of the tolerance. The reduced hulls lay inside the surface:
+    // GSO bottle p95 0.70 → 0.65 %, uncovered 25 → 8 %; YCB banana 0.25 → 0.19 %, 19 → 2 %.
+    let cap = 0.25 * opts.tolerance * s.diag;
+    let hulls = super::vhacd::decompose_one_with(&s.mesh, &o, |h, k| {
+        let g = greedy_hull(&h, k)?;
+        Some(inflate(g, h.volume, cap, k))
+    });
     let (p95, max) = distance_stats(s, &hulls)?;
     let parts = hulls
         .into_iter()

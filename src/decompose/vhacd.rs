@@ -1,6 +1,6 @@
 //! parry's V-HACD (a port of V-HACD 2.x): the baseline engine. It looks at each object alone.
 
-use super::{finish, DecomposeOptions, Decomposer, Hull};
+use super::{finish_with, DecomposeOptions, Decomposer, Hull};
 use crate::error::Result;
 use crate::mesh::{from_dvec, Mesh};
 use parry3d_f64::transformation::vhacd::{VHACDParameters, VHACD};
@@ -22,6 +22,15 @@ impl Decomposer for Vhacd {
 
 /// V-HACD of one mesh, brought within the limits.
 pub fn decompose_one(mesh: &Mesh, opts: &DecomposeOptions) -> Vec<Hull> {
+    decompose_one_with(mesh, opts, Hull::simplified)
+}
+
+/// [`decompose_one`] with another way (`reduce`) to bring a hull down to `max_vertices`.
+pub fn decompose_one_with(
+    mesh: &Mesh,
+    opts: &DecomposeOptions,
+    reduce: impl Fn(Hull, usize) -> Option<Hull> + Copy,
+) -> Vec<Hull> {
     let params = VHACDParameters {
         resolution: opts.resolution,
         concavity: opts.concavity,
@@ -37,10 +46,10 @@ pub fn decompose_one(mesh: &Mesh, opts: &DecomposeOptions) -> Vec<Hull> {
             .collect()
     })
     .unwrap_or_default();
-    let mut hulls = finish(raw, opts);
+    let mut hulls = finish_with(raw, opts, reduce);
     if hulls.is_empty() {
         // V-HACD found nothing usable (thin or tiny object): fall back to the convex hull.
-        hulls = finish(vec![mesh.vertices.clone()], opts);
+        hulls = finish_with(vec![mesh.vertices.clone()], opts, reduce);
     }
     hulls
 }
