@@ -50,7 +50,8 @@
 //!    Once the budget is spent the patches are rebalanced and polished (`rebalance.rs`,
 //!    `polish.rs`: moves that bring the far tail of the surface distance closer, where the
 //!    loop above chases each hull's maximum), next to neighbours with the patches they may
-//!    touch pinned. An object alone also runs a second strategy, `Strategy::Planes` (top-down
+//!    touch pinned; then the free two-sided segments are rebuilt from all their patch's
+//!    vertices (`refit.rs`), which covers more of the surface. An object alone also runs a second strategy, `Strategy::Planes` (top-down
 //!    from 2 patches, with plane cuts across the scene axes among the split candidates) and
 //!    keeps whichever lies closer to the surface at the 95th percentile.
 //! 3. **Neighbour refinement** at the composed pose. Every pair of hulls of different objects
@@ -77,6 +78,7 @@ pub mod metrics;
 pub mod patches;
 mod polish;
 mod rebalance;
+mod refit;
 
 use super::{cache, DecomposeOptions, Decomposer, Hull};
 use crate::error::Result;
@@ -89,7 +91,7 @@ use std::sync::Mutex;
 /// Engine name, recorded in reports and in the cache key.
 pub const NAME: &str = "scene_aware";
 /// Bumped whenever the output for the same input changes (invalidates the cache).
-pub const VERSION: u32 = 12;
+pub const VERSION: u32 = 13;
 
 /// What happened to one object.
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
@@ -110,6 +112,10 @@ pub struct ObjectReport {
     pub polish_rounds: usize,
     #[serde(default)]
     pub trimmed_patches: usize,
+    /// Wall segments rebuilt from all their patch's vertices once the patches were final
+    /// (see `refit.rs`).
+    #[serde(default)]
+    pub refitted: usize,
     /// The patches were found top-down, with plane cuts normal to the scene axes, which
     /// measured closer to the surface than the bottom-up patches (see `Strategy`).
     #[serde(default)]
@@ -1269,6 +1275,7 @@ fn grow_parts(
                 polish::polish(s, feat, p, opts, &mut parts, effort.polish, near);
         }
     }
+    report.refitted = refit::refit(s, p, opts, &mut parts, near);
     p.memo.clear();
     (parts, report)
 }

@@ -833,3 +833,48 @@ fn point_triangle_distance_of_degenerate_triangles_is_that_of_their_edges() {
         2.0
     );
 }
+
+/// The refit (`refit.rs`) covers more of the surface: the bowl fixture's final wall segments,
+/// each rebuilt the way the search builds them (farthest-point-sampled vertices per side), leave
+/// more of the bowl's surface more than 0.1 % of the diagonal outside every hull than the
+/// refitted ones (measured 3.4 → 2.9 %, 8 of 32 refitted). A refitted hull deviates no more than the sampled one,
+/// and its vertices are its patch's own mesh vertices.
+#[test]
+fn refitting_wall_segments_covers_more_of_the_surface() {
+    let o = opts();
+    let mesh = world_meshes(&fixture("ball_bowl")).remove(0);
+    let b = o.max_hulls;
+    let obj = decompose_alone(&mesh, &o, b, Effort::full(b), &Strategy::ALL);
+    let (s, p) = (obj.surf.as_ref().unwrap(), obj.params.as_ref().unwrap());
+    assert!(obj.report.refitted > 0, "{:?}", obj.report);
+    let mut rebuilt = 0;
+    let sampled: Vec<Hull> = obj
+        .parts
+        .iter()
+        .map(|q| {
+            let old = build_part(s, p, &o, q.tris.clone(), q.cuts.clone()).unwrap();
+            if old.hull != q.hull {
+                rebuilt += 1;
+                assert!(q.dev <= old.dev, "{} > {}", q.dev, old.dev);
+                assert!(q.hull.vertices.len() <= o.max_vertices);
+                for v in &q.hull.vertices {
+                    assert!(
+                        q.tris.iter().any(|&t| s.mesh.triangles[t as usize]
+                            .iter()
+                            .any(|&i| s.mesh.vertices[i as usize] == *v)),
+                        "{v:?} is not a vertex of the patch"
+                    );
+                }
+            }
+            old.hull
+        })
+        .collect();
+    assert_eq!(rebuilt, obj.report.refitted);
+    let refitted: Vec<Hull> = obj.parts.iter().map(|q| q.hull.clone()).collect();
+    let (before, after) = (
+        metrics::uncovered(s, &sampled, 8_000),
+        metrics::uncovered(s, &refitted, 8_000),
+    );
+    eprintln!("bowl: uncovered {before:.4} -> {after:.4}, {rebuilt} refitted");
+    assert!(after <= 0.95 * before, "{before} -> {after}");
+}
