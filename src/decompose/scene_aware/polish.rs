@@ -185,6 +185,8 @@ pub(super) fn polish(
     let mut next_id = parts.len() as u64;
     // Merges by the pair of part ids; `None`: none, or one lifting a hull above a floor.
     let mut merged: BTreeMap<(u64, u64), Option<Sampled>> = BTreeMap::new();
+    // Lifts of the current parts, by id.
+    let mut lift_of: BTreeMap<u64, f64> = BTreeMap::new();
     let mut stuck: Vec<u64> = Vec::new();
     let (mut kept, mut failed) = (0, 0);
     for _ in 0..2 * rounds {
@@ -210,7 +212,13 @@ pub(super) fn polish(
             break;
         };
         let adj = adjacency(s, parts);
-        let lifts: Vec<f64> = parts.iter().map(|q| lift(s, &q.hull, &q.tris)).collect();
+        let lifts: Vec<f64> = (0..parts.len())
+            .map(|k| {
+                *lift_of
+                    .entry(ids[k])
+                    .or_insert_with(|| lift(s, &parts[k].hull, &parts[k].tris))
+            })
+            .collect();
         let top = |i: usize, j: usize| lifts[i].max(lifts[j]).max(CONTACT_DEV * p.tol);
         // Of the ways to split in two, the one leaving least excess, with the other hulls but
         // `skip`.

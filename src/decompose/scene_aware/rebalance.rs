@@ -51,7 +51,9 @@ pub(super) fn rebalance(
     let is_pinned = |tris: &[u32], dev: f64| pinned(near, tris, dev, p, opts);
     let mut ids: Vec<u64> = (0..parts.len() as u64).collect();
     let mut next_id = parts.len() as u64;
-    let mut merged: BTreeMap<(u64, u64), Option<Part>> = BTreeMap::new();
+    // Merges, with their lift, by the pair of part ids; lifts of the current parts by id.
+    let mut merged: BTreeMap<(u64, u64), Option<(Part, f64)>> = BTreeMap::new();
+    let mut lift_of: BTreeMap<u64, f64> = BTreeMap::new();
     let mut kept = 0;
     // Patches whose best split does not go below their own deviation (by id): skipped, and the
     // next worst is tried instead.
@@ -81,22 +83,30 @@ pub(super) fn rebalance(
         // Adjacent pairs, w excluded, in index order.
         let pairs: Vec<(usize, usize)> = adjacent_pairs(&adj, w);
         // How far each hull rises above its patch's up-facing triangles.
-        let lifts: Vec<f64> = parts.iter().map(|q| lift(s, &q.hull, &q.tris)).collect();
+        let lifts: Vec<f64> = (0..parts.len())
+            .map(|k| {
+                *lift_of
+                    .entry(ids[k])
+                    .or_insert_with(|| lift(s, &parts[k].hull, &parts[k].tris))
+            })
+            .collect();
         let missing: Vec<(usize, usize)> = pairs
             .iter()
             .copied()
             .filter(|&(i, j)| !merged.contains_key(&(ids[i], ids[j])))
             .collect();
-        let built: Vec<Option<Part>> = missing
+        let built: Vec<Option<(Part, f64)>> = missing
             .par_iter()
             .map(|&(i, j)| {
-                build_part(
+                let m = build_part(
                     s,
                     p,
                     opts,
                     union(&parts[i], &parts[j]),
                     parts[i].cuts.clone(),
-                )
+                )?;
+                let l = lift(s, &m.hull, &m.tris);
+                Some((m, l))
             })
             .collect();
         for (&(i, j), b) in missing.iter().zip(built) {
@@ -105,15 +115,14 @@ pub(super) fn rebalance(
         // A merge may not lift the hull above an up-facing surface (a floor, where something
         // may be put later) more than the two hulls did: it would rest on the merged chord.
         let top = |i: usize, j: usize| lifts[i].max(lifts[j]).max(CONTACT_DEV * p.tol);
-        let allowed = |i: usize, j: usize, m: &Part| lift(s, &m.hull, &m.tris) <= top(i, j);
         let best = pairs
             .iter()
             .filter_map(|&(i, j)| {
-                let m = merged.get(&(ids[i], ids[j]))?.as_ref()?;
+                let (m, m_lift) = merged.get(&(ids[i], ids[j]))?.as_ref()?;
                 let free = [&parts[i], &parts[j], m]
                     .iter()
                     .all(|q| !is_pinned(&q.tris, q.dev));
-                (allowed(i, j, m) && free).then_some((m.dev, i, j))
+                (*m_lift <= top(i, j) && free).then_some((m.dev, i, j))
             })
             .min_by(|a, b| a.0.total_cmp(&b.0).then((a.1, a.2).cmp(&(b.1, b.2))));
         // Move 1: merge the best pair, split w.
@@ -157,7 +166,7 @@ pub(super) fn rebalance(
             continue;
         };
         let (_, i, j) = best.expect("move 1 needs a merge");
-        let m = merged
+        let (m, _) = merged
             .remove(&(ids[i], ids[j]))
             .flatten()
             .expect("merge was just found");
