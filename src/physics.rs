@@ -2,7 +2,7 @@
 //!
 //! A composed scene places objects at poses chosen by a generator: millimetre gaps, round bottoms
 //! that still have to rock into place. Those poses are not rest poses, so the check runs in two
-//! phases on a Rapier world (floor at z = 0, gravity along −z, one dynamic or fixed body per
+//! phases on a Rapier world (floor at z = 0, to [`FLOOR_GAP`], gravity along −z, one dynamic or fixed body per
 //! object, one convex collider per hull, the exported mass properties):
 //!
 //! 1. **Settle**: simulate from the composed pose until every dynamic body sleeps (capped). The
@@ -529,6 +529,15 @@ pub fn rapier_mass_properties(body: &SimBody) -> Result<(f64, P3, Matrix3<f64>),
     ))
 }
 
+/// How far below z = 0 the floor's top face lies (m). Prepared scenes rest on z = 0, and a
+/// hull's lowest vertex ends up there only to f64 rounding: 1.4e-17 m *above* it, say. At such
+/// a separation, below GJK's tolerance, parry's contact query gives a hull touching the floor
+/// at a sharp vertex (the apex of a basket floor's pie slice) a normal pointing up out of the
+/// floor, in about half the cases; Rapier then slid the fixture basket 2.4 mm and rolled its
+/// fruits out. Exactly at 0, below it, or 1e-12 m above it, the normals are right. 10 nm is
+/// far above the rounding and far below anything the checks measure.
+pub const FLOOR_GAP: f64 = 1e-8;
+
 /// Number of whole steps of length `dt` covering `time` (rounded to nearest).
 fn steps_for(time: f64, dt: f64) -> usize {
     (time / dt).round().max(0.0) as usize
@@ -712,13 +721,13 @@ impl<'a> Sim<'a> {
                     .fold(0.0, f64::max),
             );
         }
-        // The floor: a large thin fixed box whose top face is z = 0 (a cuboid rather than a
-        // half-space, see shared/notes/crates.md).
+        // The floor: a large thin fixed box whose top face is `FLOOR_GAP` below z = 0 (a cuboid
+        // rather than a half-space, see shared/notes/crates.md).
         let half = 10.0 * scene_extent;
         let floor = world.insert_body(RigidBodyBuilder::fixed().translation(Vector::new(
             0.0,
             0.0,
-            -0.5 * scene_extent,
+            -0.5 * scene_extent - FLOOR_GAP,
         )));
         world.insert_collider(
             ColliderBuilder::cuboid(half, half, 0.5 * scene_extent)
