@@ -2,8 +2,8 @@
 //!
 //! A composed scene places objects at poses chosen by a generator: millimetre gaps, round bottoms
 //! that still have to rock into place. Those poses are not rest poses, so the check runs in two
-//! phases on a Rapier world (floor at z = 0, to [`FLOOR_GAP`], gravity along −z, one dynamic or fixed body per
-//! object, one convex collider per hull, the exported mass properties):
+//! phases on a Rapier world (floor at z = 0, to [`FLOOR_GAP`], gravity along −z, one dynamic or
+//! fixed body per object, one convex collider per hull, the exported mass properties):
 //!
 //! 1. **Settle**: simulate from the composed pose until every dynamic body sleeps (capped). The
 //!    drift from the composed pose (centre-of-mass displacement, rotation angle) must stay small

@@ -51,9 +51,10 @@
 //!    `polish.rs`: moves that bring the far tail of the surface distance closer, where the
 //!    loop above chases each hull's maximum), next to neighbours with the patches they may
 //!    touch pinned; then the free two-sided segments are rebuilt from all their patch's
-//!    vertices (`refit.rs`), which covers more of the surface. An object alone also runs a second strategy, `Strategy::Planes` (top-down
-//!    from 2 patches, with plane cuts across the scene axes among the split candidates) and
-//!    keeps whichever lies closer to the surface at the 95th percentile.
+//!    vertices (`refit.rs`), which covers more of the surface. An object alone also runs a
+//!    second strategy, `Strategy::Planes` (top-down from 2 patches, with plane cuts across the
+//!    scene axes among the split candidates) and keeps whichever lies closer to the surface at
+//!    the 95th percentile.
 //! 3. **Neighbour refinement** at the composed pose. Every pair of hulls of different objects
 //!    closer than `clearance` (exact convex–convex queries in f64) is resolved: when the
 //!    convex hulls of the two patches' *surface points* are apart, both hulls are clipped by

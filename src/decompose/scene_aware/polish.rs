@@ -46,7 +46,7 @@
 
 use super::geom::{sample_hull, Surface};
 use super::patches::Features;
-use super::rebalance::{adjacency, adjacent_pairs, lift, pinned, union};
+use super::rebalance::{adjacency, adjacent_pairs, lift, lifts_by_id, pinned, union};
 use super::{build_part, hulls_of, metrics, split_candidates, Params, Part, CONTACT_DEV};
 use crate::decompose::{DecomposeOptions, Hull};
 use rayon::prelude::*;
@@ -212,13 +212,7 @@ pub(super) fn polish(
             break;
         };
         let adj = adjacency(s, parts);
-        let lifts: Vec<f64> = (0..parts.len())
-            .map(|k| {
-                *lift_of
-                    .entry(ids[k])
-                    .or_insert_with(|| lift(s, &parts[k].hull, &parts[k].tris))
-            })
-            .collect();
+        let lifts: Vec<f64> = lifts_by_id(s, parts, &ids, &mut lift_of);
         let top = |i: usize, j: usize| lifts[i].max(lifts[j]).max(CONTACT_DEV * p.tol);
         // Of the ways to split in two, the one leaving least excess, with the other hulls but
         // `skip`.

@@ -83,13 +83,7 @@ pub(super) fn rebalance(
         // Adjacent pairs, w excluded, in index order.
         let pairs: Vec<(usize, usize)> = adjacent_pairs(&adj, w);
         // How far each hull rises above its patch's up-facing triangles.
-        let lifts: Vec<f64> = (0..parts.len())
-            .map(|k| {
-                *lift_of
-                    .entry(ids[k])
-                    .or_insert_with(|| lift(s, &parts[k].hull, &parts[k].tris))
-            })
-            .collect();
+        let lifts: Vec<f64> = lifts_by_id(s, parts, &ids, &mut lift_of);
         let missing: Vec<(usize, usize)> = pairs
             .iter()
             .copied()
@@ -228,6 +222,25 @@ pub(super) fn lift(s: &Surface, h: &crate::decompose::Hull, tris: &[u32]) -> f64
         }
     }
     worst
+}
+
+/// [`lift`] of each part, computed once per part id (`ids[k]` names `parts[k]`; a part gets a
+/// new id when it changes) and kept in `cache`.
+pub(super) fn lifts_by_id(
+    s: &Surface,
+    parts: &[Part],
+    ids: &[u64],
+    cache: &mut BTreeMap<u64, f64>,
+) -> Vec<f64> {
+    parts
+        .iter()
+        .zip(ids)
+        .map(|(q, id)| {
+            *cache
+                .entry(*id)
+                .or_insert_with(|| lift(s, &q.hull, &q.tris))
+        })
+        .collect()
 }
 
 /// The pairs of adjacent patches (`i < j`), `w` excluded, in index order.
