@@ -129,6 +129,19 @@ impl Mesh {
             .all(|(&(a, b), &n)| n == 1 && edges.get(&(b, a)) == Some(&1))
     }
 
+    /// How many directed edges are used by more than one triangle: 0 when the mesh is
+    /// consistently oriented (two triangles sharing an edge run it in opposite directions).
+    /// Scans have a few, where more than two triangles meet on an edge (YCB mug: 6 of 49,128).
+    pub fn misoriented_edges(&self) -> usize {
+        let mut edges: Vec<(u32, u32)> = self
+            .triangles
+            .iter()
+            .flat_map(|t| (0..3).map(move |k| (t[k], t[(k + 1) % 3])))
+            .collect();
+        edges.sort_unstable();
+        edges.windows(2).filter(|w| w[0] == w[1]).count()
+    }
+
     /// Apply a 4x4 affine transform to every vertex. A transform with negative determinant
     /// flips the triangle winding back so outward normals stay outward.
     pub fn transformed(&self, m: &Matrix4<f64>) -> Mesh {

@@ -20,6 +20,11 @@ pub struct Surface {
     corners: Vec<[Vector; 3]>,
     /// Watertight and consistently oriented: inside tests are meaningful.
     pub closed: bool,
+    /// Closed, or nearly so: facing out, with at most one directed edge in a thousand used
+    /// twice (scans where more than two triangles meet on an edge). The side of the surface a
+    /// point is on, by the nearest feature's pseudo-normal, is then meaningful but next to
+    /// those few edges ([`Surface::max_distance_outside`]).
+    pub sided: bool,
     pub aabb: Aabb,
     pub diag: f64,
     pub tri_normal: Vec<V3>,
@@ -43,6 +48,9 @@ impl Surface {
                 t.swap(1, 2);
             }
         }
+        let sided = closed
+            || (mesh.misoriented_edges() * 1000 <= 3 * mesh.triangles.len()
+                && volume_about(&mesh, aabb.center()) > 0.0);
         let (v, t) = mesh.to_parry();
         let tri = TriMesh::with_flags(v, t, TriMeshFlags::ORIENTED).ok()?;
         let corners = (0..tri.indices().len() as u32)
@@ -80,6 +88,7 @@ impl Surface {
             tri,
             corners,
             closed,
+            sided,
             aabb,
             tri_normal,
             tri_area,
@@ -132,10 +141,23 @@ impl Surface {
     /// The largest [`Surface::distance`] of `pts`, exactly: a point within the largest so far
     /// costs only a [`Surface::within`] test. Pass the points likeliest to be far first.
     pub fn max_distance<'a>(&self, pts: impl IntoIterator<Item = &'a P3>) -> f64 {
+        self.max_distance_seams(pts, -1.0)
+    }
+
+    /// [`Surface::max_distance`] but for the points inside the material within `seam` of the
+    /// surface, which are not counted: by the pseudo-normal of the nearest feature (parry's
+    /// `is_inside`, which comes with the projection). Every point counts on a surface that is
+    /// not [`Surface::sided`], and for `seam < 0` ([`Surface::max_distance`]).
+    pub fn max_distance_seams<'a>(&self, pts: impl IntoIterator<Item = &'a P3>, seam: f64) -> f64 {
         let mut m: f64 = 0.0;
         for p in pts {
             if !(m > 0.0 && self.within(p, m * (1.0 - WITHIN_MARGIN))) {
-                m = m.max(self.distance(p));
+                let q = to_dvec(p);
+                let proj = self.tri.project_point(&Pose::identity(), q, false);
+                let d = (proj.point - q).length();
+                if !(self.sided && proj.is_inside && d <= seam) {
+                    m = m.max(d);
+                }
             }
         }
         m
@@ -191,6 +213,17 @@ impl Surface {
             .collect();
         sample_triangles(&tris, n, seed)
     }
+}
+
+/// Signed volume enclosed by `m` about `c`: for a closed mesh the same about any point; for a
+/// scan with small holes, about its centre, close to what it would be closed.
+fn volume_about(m: &Mesh, c: P3) -> f64 {
+    (0..m.triangles.len())
+        .map(|i| {
+            let [a, b, d] = m.triangle(i).map(|q| q - c);
+            a.dot(&b.cross(&d)) / 6.0
+        })
+        .sum()
 }
 
 /// `n` points on a triangle set, stratified by area (deterministic for a given `seed`).

@@ -59,7 +59,7 @@ pub(super) fn refit(
                 return 0;
             };
             // Every vertex of `g` is a mesh vertex: none needs a distance query.
-            let dev = deviation(s, &g, q.tris[0] as u64, &g.vertices);
+            let dev = deviation(s, &g, q.tris[0] as u64, &g.vertices, Some(p.seam_depth()));
             if dev > q.dev {
                 return 0;
             }

@@ -7,6 +7,7 @@ use crate::mesh::{Mesh, P3, V3};
 use crate::shapes;
 use parry3d_f64::math::{Pose, Vector};
 use parry3d_f64::shape::ConvexPolyhedron;
+use std::f64::consts::PI;
 use std::path::{Path, PathBuf};
 
 fn opts() -> DecomposeOptions {
@@ -702,9 +703,9 @@ fn star_pieces_fill_a_dimpled_solid_and_keep_the_dimple_open() {
     let r = 0.04;
     let n = 48;
     let dimple = |phi: f64| 1.0 - 0.3 * (-(phi / 0.35).powi(2)).exp();
-    let mut profile: Vec<[f64; 2]> = vec![[0.0, -r * dimple(std::f64::consts::PI)]];
+    let mut profile: Vec<[f64; 2]> = vec![[0.0, -r * dimple(PI)]];
     profile.extend((1..n).map(|i| {
-        let phi = std::f64::consts::PI * (1.0 - i as f64 / n as f64);
+        let phi = PI * (1.0 - i as f64 / n as f64);
         [r * dimple(phi) * phi.sin(), r * dimple(phi) * phi.cos()]
     }));
     profile.push([0.0, r * dimple(0.0)]);
@@ -877,4 +878,45 @@ fn refitting_wall_segments_covers_more_of_the_surface() {
     );
     eprintln!("bowl: uncovered {before:.4} -> {after:.4}, {rebuilt} refitted");
     assert!(after <= 0.95 * before, "{before} -> {after}");
+}
+
+#[test]
+fn a_wall_segments_end_faces_are_seams_and_only_its_chord_deviates() {
+    // The mug fixture's cup: 4 mm wall, inner radius 36 mm, 64 slices. A segment of 4 slices
+    // (22.5°) of both sides of the wall: its inner face is the chord across the 4 inner facets,
+    // r·(1 − cos 11.25°) = 0.69 mm from the inner wall at most. Its end faces cross the wall,
+    // 2 mm from the surface at their middle, and its foot crosses the 6 mm floor slab, up to
+    // 3 mm from it: more than the 1.48 mm tolerance, and all inside the material.
+    let (r, wall, floor) = (0.04, 0.004, 0.006);
+    let mesh = shapes::mug(r, 0.095, wall, floor, 64);
+    let s = Surface::new(&mesh).unwrap();
+    assert!(s.closed && s.sided);
+    let o = opts();
+    let p = Params::new(&s, &o, Strategy::Patches);
+    let angle = |q: &P3| q.y.atan2(q.x);
+    let tris: Vec<u32> = (0..mesh.triangles.len() as u32)
+        .filter(|&t| {
+            s.tri_normal[t as usize].z.abs() < 0.1
+                && mesh.triangle(t as usize).iter().all(|q| {
+                    let a = angle(q);
+                    (-1e-9..=PI / 8.0 + 1e-9).contains(&a)
+                })
+        })
+        .collect();
+    assert_eq!(tris.len(), 16, "4 slices, 2 triangles each, both sides");
+    let part = build_part(&s, &p, &o, tris.clone(), Vec::new()).unwrap();
+    assert_eq!(part.normal, V3::zeros(), "a two-sided wall segment");
+    let chord = (r - wall) * (1.0 - (PI / 16.0).cos());
+    let all = deviation(&s, &part.hull, tris[0] as u64, &part.outer, None);
+    eprintln!(
+        "segment: {:.3} mm with seams, {:.3} mm counting every face; chord {:.3} mm, tolerance {:.3} mm",
+        part.dev * 1e3,
+        all * 1e3,
+        chord * 1e3,
+        p.tol * 1e3
+    );
+    assert!(part.dev <= chord * (1.0 + 1e-9), "{} > {chord}", part.dev);
+    assert!(part.dev >= 0.8 * chord, "{} < 0.8 × {chord}", part.dev);
+    assert!(all >= wall / 2.0 && all <= floor / 2.0 + 1e-9, "{all}");
+    assert!(part.dev < p.tol && all > p.tol);
 }
