@@ -129,17 +129,24 @@ impl Mesh {
             .all(|(&(a, b), &n)| n == 1 && edges.get(&(b, a)) == Some(&1))
     }
 
-    /// How many directed edges are used by more than one triangle: 0 when the mesh is
-    /// consistently oriented (two triangles sharing an edge run it in opposite directions).
-    /// Scans have a few, where more than two triangles meet on an edge (YCB mug: 6 of 49,128).
-    pub fn misoriented_edges(&self) -> usize {
+    /// Edge defects, as `(doubled, open)`: directed edges used by more than one triangle (0
+    /// when the mesh is consistently oriented: two triangles sharing an edge run it in
+    /// opposite directions) and directed edges that no triangle runs the other way (0 when
+    /// every edge is shared: no hole). Scans have a few doubled edges where more than two
+    /// triangles meet on an edge (YCB mug: 6 of 49,128 directed edges, none open).
+    pub fn edge_defects(&self) -> (usize, usize) {
         let mut edges: Vec<(u32, u32)> = self
             .triangles
             .iter()
             .flat_map(|t| (0..3).map(move |k| (t[k], t[(k + 1) % 3])))
             .collect();
         edges.sort_unstable();
-        edges.windows(2).filter(|w| w[0] == w[1]).count()
+        let doubled = edges.windows(2).filter(|w| w[0] == w[1]).count();
+        let open = edges
+            .iter()
+            .filter(|&&(a, b)| edges.binary_search(&(b, a)).is_err())
+            .count();
+        (doubled, open)
     }
 
     /// Apply a 4x4 affine transform to every vertex. A transform with negative determinant

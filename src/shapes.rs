@@ -741,6 +741,18 @@ mod tests {
     }
 
     #[test]
+    fn edge_defects_count_holes_and_doubled_edges() {
+        let mut m = cuboid(V3::new(1.0, 2.0, 3.0));
+        assert_eq!(m.edge_defects(), (0, 0));
+        // A triangle removed: a hole rimmed by its 3 edges.
+        let t = m.triangles.pop().unwrap();
+        assert_eq!(m.edge_defects(), (0, 3));
+        // Put back twice: its 3 edges run twice the same way, and no hole.
+        m.triangles.extend([t, t]);
+        assert_eq!(m.edge_defects(), (3, 0));
+    }
+
+    #[test]
     fn shelf_is_closed_with_the_boxes_volume() {
         let (w, d, h, t) = (0.4, 0.25, 0.6, 0.018);
         let m = shelf(w, d, h, t, &[0.05, 0.3, 0.55]);

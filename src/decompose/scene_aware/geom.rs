@@ -20,10 +20,11 @@ pub struct Surface {
     corners: Vec<[Vector; 3]>,
     /// Watertight and consistently oriented: inside tests are meaningful.
     pub closed: bool,
-    /// Closed, or nearly so: facing out, with at most one directed edge in a thousand used
-    /// twice (scans where more than two triangles meet on an edge). The side of the surface a
-    /// point is on, by the nearest feature's pseudo-normal, is then meaningful but next to
-    /// those few edges ([`Surface::max_distance_outside`]).
+    /// Closed, or nearly so: no hole, facing out, with at most one directed edge in a
+    /// thousand used twice (scans where more than two triangles meet on an edge). The side of
+    /// the surface a point is on, by the nearest feature's pseudo-normal, is then meaningful
+    /// but next to those few edges ([`Surface::max_distance_seams`]). Not for a mesh with
+    /// holes: near a hole's rim the nearest feature's side says nothing about the point.
     pub sided: bool,
     pub aabb: Aabb,
     pub diag: f64,
@@ -48,9 +49,12 @@ impl Surface {
                 t.swap(1, 2);
             }
         }
-        let sided = closed
-            || (mesh.misoriented_edges() * 1000 <= 3 * mesh.triangles.len()
-                && volume_about(&mesh, aabb.center()) > 0.0);
+        let sided = closed || {
+            let (doubled, open) = mesh.edge_defects();
+            open == 0
+                && doubled * 1000 <= 3 * mesh.triangles.len()
+                && volume_about(&mesh, aabb.center()) > 0.0
+        };
         let (v, t) = mesh.to_parry();
         let tri = TriMesh::with_flags(v, t, TriMeshFlags::ORIENTED).ok()?;
         let corners = (0..tri.indices().len() as u32)
