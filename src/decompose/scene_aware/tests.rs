@@ -856,7 +856,7 @@ fn refitting_wall_segments_covers_more_of_the_surface() {
             let old = build_part(s, p, &o, q.tris.clone(), q.cuts.clone()).unwrap();
             if old.hull != q.hull {
                 rebuilt += 1;
-                assert!(q.dev <= old.dev, "{} > {}", q.dev, old.dev);
+                assert!(q.dev <= old.dev.max(p.tol), "{} > {}", q.dev, old.dev);
                 assert!(q.hull.vertices.len() <= o.max_vertices);
                 for v in &q.hull.vertices {
                     assert!(
