@@ -113,20 +113,9 @@ impl Mesh {
     }
 
     /// Closed (watertight and consistently oriented): every directed edge appears once and its
-    /// reverse appears once.
+    /// reverse appears once, i.e. no [`Mesh::edge_defects`].
     pub fn is_closed(&self) -> bool {
-        if self.triangles.is_empty() {
-            return false;
-        }
-        let mut edges: HashMap<(u32, u32), i32> = HashMap::with_capacity(self.triangles.len() * 3);
-        for t in &self.triangles {
-            for k in 0..3 {
-                *edges.entry((t[k], t[(k + 1) % 3])).or_insert(0) += 1;
-            }
-        }
-        edges
-            .iter()
-            .all(|(&(a, b), &n)| n == 1 && edges.get(&(b, a)) == Some(&1))
+        !self.triangles.is_empty() && self.edge_defects() == (0, 0)
     }
 
     /// Edge defects, as `(doubled, open)`: directed edges used by more than one triangle (0

@@ -43,18 +43,18 @@ impl Surface {
             return None;
         }
         let mut mesh = mesh.clone();
-        let closed = mesh.is_closed();
+        let (doubled, open) = mesh.edge_defects();
+        let closed = doubled == 0 && open == 0; // `Mesh::is_closed`, triangles checked above
         if closed && mesh.signed_volume() < 0.0 {
             for t in &mut mesh.triangles {
                 t.swap(1, 2);
             }
         }
-        let sided = closed || {
-            let (doubled, open) = mesh.edge_defects();
-            open == 0
+        // Without an open edge the surface encloses a volume whatever its origin.
+        let sided = closed
+            || (open == 0
                 && doubled * 1000 <= 3 * mesh.triangles.len()
-                && volume_about(&mesh, aabb.center()) > 0.0
-        };
+                && mesh.signed_volume() > 0.0);
         let (v, t) = mesh.to_parry();
         let tri = TriMesh::with_flags(v, t, TriMeshFlags::ORIENTED).ok()?;
         let corners = (0..tri.indices().len() as u32)
@@ -217,17 +217,6 @@ impl Surface {
             .collect();
         sample_triangles(&tris, n, seed)
     }
-}
-
-/// Signed volume enclosed by `m` about `c`: for a closed mesh the same about any point; for a
-/// scan with small holes, about its centre, close to what it would be closed.
-fn volume_about(m: &Mesh, c: P3) -> f64 {
-    (0..m.triangles.len())
-        .map(|i| {
-            let [a, b, d] = m.triangle(i).map(|q| q - c);
-            a.dot(&b.cross(&d)) / 6.0
-        })
-        .sum()
 }
 
 /// `n` points on a triangle set, stratified by area (deterministic for a given `seed`).
