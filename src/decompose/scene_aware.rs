@@ -1115,8 +1115,9 @@ fn decompose_alone(
 }
 
 /// [`decompose_alone`] on a prepared surface. `near[t]`: a lower bound on how far triangle
-/// `t` is from the ground and every neighbour's collision geometry (empty: nothing is
-/// pinned); the rebalancing and the polishing leave alone the patches within reach of them.
+/// `t` is from the ground and every neighbour's collision geometry, ∞ where it may not pin
+/// its patch (see [`free_passing_walls`]; empty: nothing is pinned); the rebalancing, the
+/// polishing and the refit leave alone the patches within reach of them.
 fn decompose_object(
     surf: Option<Surface>,
     opts: &DecomposeOptions,
