@@ -160,24 +160,17 @@ fn snapshot_scenes(out: &Path, made: &[Made]) -> Vec<(String, Vec<u8>)> {
 /// (path, inode, modification time in ns) of every file under the scenes' output folders.
 fn file_identities(out: &Path, made: &[Made]) -> Vec<(String, u64, i128)> {
     use std::os::unix::fs::MetadataExt;
-    let mut v = Vec::new();
-    let mut stack: Vec<_> = made
+    let mut v: Vec<_> = made
         .iter()
         .map(|m| out.join(&m.rel))
         .filter(|d| d.exists())
+        .flat_map(|d| walk(&d))
+        .map(|f| {
+            let md = std::fs::symlink_metadata(&f).unwrap();
+            let ns = md.mtime() as i128 * 1_000_000_000 + md.mtime_nsec() as i128;
+            (f.display().to_string(), md.ino(), ns)
+        })
         .collect();
-    while let Some(p) = stack.pop() {
-        for e in std::fs::read_dir(&p).unwrap() {
-            let e = e.unwrap().path();
-            let md = std::fs::symlink_metadata(&e).unwrap();
-            if md.is_dir() {
-                stack.push(e);
-            } else {
-                let ns = md.mtime() as i128 * 1_000_000_000 + md.mtime_nsec() as i128;
-                v.push((e.display().to_string(), md.ino(), ns));
-            }
-        }
-    }
     v.sort();
     v
 }

@@ -184,7 +184,8 @@ pub fn snapshot(dir: &Path) -> Vec<(String, Vec<u8>)> {
     v
 }
 
-fn walk(dir: &Path) -> Vec<PathBuf> {
+/// Every file under `dir` (symlinks as files, not followed), depth first.
+pub fn walk(dir: &Path) -> Vec<PathBuf> {
     let mut out = Vec::new();
     for e in fs::read_dir(dir).unwrap().filter_map(|e| e.ok()) {
         let p = e.path();
