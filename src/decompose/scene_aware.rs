@@ -86,7 +86,7 @@ mod refit;
 use super::{cache, DecomposeOptions, Decomposer, Hull};
 use crate::error::Result;
 use crate::mesh::{Mesh, P3, V3};
-use geom::{clip, farthest_points, greedy_hull, polyhedron, Surface};
+use geom::{clip, distinct_sorted, farthest_points, greedy_hull, polyhedron, Surface};
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 use std::sync::Mutex;
@@ -511,9 +511,8 @@ fn build_new_part(
         }
     }
     let two_sided = a_pos.min(a_neg) >= 0.1 * (a_pos + a_neg);
-    let pick = |mut v: Vec<u32>| -> Vec<u32> {
-        v.sort_unstable();
-        v.dedup();
+    // Up to `n_outer` of the vertices `v` (distinct, ascending), spread out.
+    let pick = |v: &[u32]| -> Vec<u32> {
         let pts: Vec<P3> = v.iter().map(|&i| s.mesh.vertices[i as usize]).collect();
         farthest_points(&pts, p.n_outer)
             .into_iter()
@@ -523,7 +522,8 @@ fn build_new_part(
     let mut all: Vec<P3> = Vec::with_capacity(2 * p.n_outer);
     let mut outer = Vec::with_capacity(2 * p.n_outer);
     if two_sided {
-        for v in pick(pos).into_iter().chain(pick(neg)) {
+        let (pos, neg) = (distinct_sorted(&pos), distinct_sorted(&neg));
+        for v in pick(&pos).into_iter().chain(pick(&neg)) {
             outer.push(s.mesh.vertices[v as usize]);
         }
         all.extend_from_slice(&outer);
@@ -532,9 +532,7 @@ fn build_new_part(
         pos.extend(neg);
         // Vertex normals from this patch's triangles only: at a crease (a floor meeting a
         // wall) the whole-mesh normal would push the copies sideways, along the patch.
-        let mut vs: Vec<u32> = pos.clone();
-        vs.sort_unstable();
-        vs.dedup();
+        let vs = distinct_sorted(&pos);
         let mut vn = vec![V3::zeros(); vs.len()];
         for &t in &tris {
             let w = s.tri_normal[t as usize] * s.tri_area[t as usize];
@@ -545,7 +543,7 @@ fn build_new_part(
             }
         }
         let ray_max = p.d_max / 0.45 * 1.01;
-        for v in pick(pos) {
+        for v in pick(&vs) {
             let q = s.mesh.vertices[v as usize];
             let mut n = vs
                 .binary_search(&v)
@@ -912,12 +910,12 @@ fn convex_components(s: &Surface, opts: &DecomposeOptions, budget: usize) -> (Ve
         .collect::<Vec<_>>()
         .par_iter()
         .map(|tris| {
-            let mut vs: Vec<u32> = tris
-                .iter()
-                .flat_map(|&t| s.mesh.triangles[t as usize])
-                .collect();
-            vs.sort_unstable();
-            vs.dedup();
+            let vs = distinct_sorted(
+                &tris
+                    .iter()
+                    .flat_map(|&t| s.mesh.triangles[t as usize])
+                    .collect::<Vec<_>>(),
+            );
             let pts: Vec<P3> = vs.iter().map(|&v| s.mesh.vertices[v as usize]).collect();
             let local = |v: u32| vs.binary_search(&v).unwrap_or(0) as u32;
             let m = Mesh::new(

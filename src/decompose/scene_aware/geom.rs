@@ -339,6 +339,29 @@ pub fn distance(a: &ConvexPolyhedron, b: &ConvexPolyhedron) -> f64 {
         .unwrap_or(0.0)
 }
 
+/// The values of `v`, each once, ascending, by a bitmap over their range: the vertex indices
+/// of a patch's triangles (each several times). Sorting them instead was most of the 10 % of
+/// the sneaker's decomposition spent in sorts.
+pub fn distinct_sorted(v: &[u32]) -> Vec<u32> {
+    let (Some(&lo), Some(&hi)) = (v.iter().min(), v.iter().max()) else {
+        return Vec::new();
+    };
+    let mut bits = vec![0u64; ((hi - lo) as usize >> 6) + 1];
+    for &x in v {
+        let i = (x - lo) as usize;
+        bits[i >> 6] |= 1 << (i & 63);
+    }
+    let mut out = Vec::new();
+    for (w, &b) in bits.iter().enumerate() {
+        let mut b = b;
+        while b != 0 {
+            out.push(lo + 64 * w as u32 + b.trailing_zeros());
+            b &= b - 1;
+        }
+    }
+    out
+}
+
 /// Farthest-point sampling: indices of at most `k` points of `pts`, the first the point
 /// farthest from their centroid (ties to the lower index). Deterministic.
 pub fn farthest_points(pts: &[P3], k: usize) -> Vec<usize> {
@@ -354,24 +377,40 @@ pub fn farthest_points(pts: &[P3], k: usize) -> Vec<usize> {
                 .then(j.cmp(&i))
         })
         .unwrap();
-    // Coordinates apart and the farthest found in a second pass (the first of equals): the
-    // update then runs several points at a time, 30 % quicker on 1,000 points.
-    let xs: Vec<f64> = pts.iter().map(|p| p.x).collect();
-    let ys: Vec<f64> = pts.iter().map(|p| p.y).collect();
-    let zs: Vec<f64> = pts.iter().map(|p| p.z).collect();
+    // Coordinates apart, padded to whole lanes of `LANES` points, each lane keeping its own
+    // farthest: the update and the maximum then run several points at a time in one pass
+    // (2× quicker than one pass for each on 500 points, 3× on 10,000). The farthest is then
+    // found by value, the first of equals.
+    const LANES: usize = 8;
+    let n = pts.len();
+    let padded = n.div_ceil(LANES) * LANES;
+    let (mut xs, mut ys, mut zs) = (vec![0.0; padded], vec![0.0; padded], vec![0.0; padded]);
+    for (i, p) in pts.iter().enumerate() {
+        (xs[i], ys[i], zs[i]) = (p.x, p.y, p.z);
+    }
+    // The padding is at distance 0: never the farthest.
+    let mut dist = vec![f64::INFINITY; padded];
+    dist[n..].fill(0.0);
     let mut kept = vec![first];
-    let mut dist = vec![f64::INFINITY; pts.len()];
     let mut last = first;
     while kept.len() < k {
         let (lx, ly, lz) = (xs[last], ys[last], zs[last]);
-        for (((d, x), y), z) in dist.iter_mut().zip(&xs).zip(&ys).zip(&zs) {
-            let (dx, dy, dz) = (x - lx, y - ly, z - lz);
-            let e = dx * dx + dy * dy + dz * dz;
-            if e < *d {
-                *d = e;
+        let mut lanes = [0.0f64; LANES];
+        for (((d, x), y), z) in dist
+            .chunks_exact_mut(LANES)
+            .zip(xs.chunks_exact(LANES))
+            .zip(ys.chunks_exact(LANES))
+            .zip(zs.chunks_exact(LANES))
+        {
+            for l in 0..LANES {
+                let (dx, dy, dz) = (x[l] - lx, y[l] - ly, z[l] - lz);
+                let e = dx * dx + dy * dy + dz * dz;
+                let v = if e < d[l] { e } else { d[l] };
+                d[l] = v;
+                lanes[l] = if v > lanes[l] { v } else { lanes[l] };
             }
         }
-        let far = dist
+        let far = lanes
             .iter()
             .fold(0.0, |m: f64, &d| if d > m { d } else { m });
         if far <= 0.0 {

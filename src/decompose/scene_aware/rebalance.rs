@@ -260,7 +260,8 @@ pub(super) fn adjacent_pairs(adj: &[Vec<usize>], w: usize) -> Vec<(usize, usize)
 pub(super) fn union(a: &Part, b: &Part) -> Vec<u32> {
     let mut tris = a.tris.clone();
     tris.extend_from_slice(&b.tris);
-    tris.sort_unstable();
+    // Two ascending runs: the stable sort finds and merges them in one pass.
+    tris.sort();
     tris
 }
 

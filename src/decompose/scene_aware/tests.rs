@@ -921,3 +921,71 @@ fn a_wall_segments_end_faces_are_seams_and_only_its_chord_deviates() {
     assert!(all >= wall / 2.0 && all <= floor / 2.0 + 1e-9, "{all}");
     assert!(part.dev < p.tol && all > p.tol);
 }
+
+/// The lane-wise farthest-point sampling picks what the textbook greedy picks: each next
+/// point the one farthest from those kept, the lower index among equals. On a random cloud
+/// whose size is not a whole number of lanes, and on a lattice, where ties are everywhere.
+#[test]
+fn farthest_points_is_the_greedy_farthest_first_order() {
+    fn greedy(pts: &[P3], k: usize) -> Vec<usize> {
+        let c = pts.iter().fold(V3::zeros(), |a, p| a + p.coords) / pts.len() as f64;
+        let mut best = 0;
+        for i in 1..pts.len() {
+            if (pts[i].coords - c).norm_squared() > (pts[best].coords - c).norm_squared() {
+                best = i;
+            }
+        }
+        let mut kept = vec![best];
+        while kept.len() < k.min(pts.len()) {
+            let gap = |i: usize| {
+                kept.iter()
+                    .map(|&j| (pts[i] - pts[j]).norm_squared())
+                    .fold(f64::INFINITY, f64::min)
+            };
+            let mut far = 0;
+            for i in 1..pts.len() {
+                if gap(i) > gap(far) {
+                    far = i;
+                }
+            }
+            if gap(far) <= 0.0 {
+                break;
+            }
+            kept.push(far);
+        }
+        kept
+    }
+    let mut rng = crate::rng::Rng::new(11);
+    let cloud: Vec<P3> = (0..203)
+        .map(|_| P3::new(rng.next_f64(), rng.next_f64(), rng.next_f64()))
+        .collect();
+    let lattice: Vec<P3> = (0..5 * 5 * 3)
+        .map(|i| P3::new((i % 5) as f64, (i / 5 % 5) as f64, (i / 25) as f64))
+        .collect();
+    for pts in [&cloud, &lattice] {
+        for k in [1, 8, 32, 74] {
+            assert_eq!(geom::farthest_points(pts, k), greedy(pts, k), "k = {k}");
+        }
+    }
+    // Duplicates only: one point, then nothing is farther.
+    assert_eq!(geom::farthest_points(&[P3::origin(); 20], 5), vec![0]);
+}
+
+#[test]
+fn distinct_sorted_is_sort_and_dedup() {
+    let mut rng = crate::rng::Rng::new(3);
+    for (n, range) in [
+        (0, 1),
+        (1, 1),
+        (50, 10),
+        (1000, 100_000),
+        (300, 64),
+        (70, 65),
+    ] {
+        let v: Vec<u32> = (0..n).map(|_| 5 + rng.below(range) as u32).collect();
+        let mut want = v.clone();
+        want.sort_unstable();
+        want.dedup();
+        assert_eq!(geom::distinct_sorted(&v), want, "{n} values below {range}");
+    }
+}
