@@ -294,7 +294,7 @@ pub(super) fn polish(
         if let Some((added, i, j)) = merge {
             let limit = lifts[w].max(CONTACT_DEV * p.tol);
             if let Some((e, _, a, b)) = best_halves(
-                split_candidates(s, f, p, opts, &parts[w], true),
+                split_candidates(s, f, p, opts, &parts[w], true, f64::INFINITY),
                 &[w],
                 limit,
             ) {
@@ -327,7 +327,7 @@ pub(super) fn polish(
                         ..parts[w].clone()
                     };
                     let (e, _, a, b) = best_halves(
-                        split_candidates(s, f, p, opts, &both, true),
+                        split_candidates(s, f, p, opts, &both, true, f64::INFINITY),
                         &[w, j],
                         top(w, j),
                     )?;

@@ -122,8 +122,7 @@ pub(super) fn rebalance(
         // Move 1: merge the best pair, split w.
         let halves = best
             .filter(|&(m_dev, _, _)| m_dev < worst)
-            .and_then(|_| split(s, f, p, opts, &parts[w]))
-            .filter(|(a, b)| a.dev.max(b.dev) < worst);
+            .and_then(|_| split(s, f, p, opts, &parts[w], worst));
         let Some((a, b)) = halves else {
             // Move 2: move w's border with one of its neighbours (merge the two, split again)
             // when that brings both below w's deviation.
@@ -135,9 +134,8 @@ pub(super) fn rebalance(
                         tris: union(&parts[w], &parts[j]),
                         ..parts[w].clone()
                     };
-                    let (a, b) = split(s, f, p, opts, &both)?;
-                    let ok = a.dev.max(b.dev) < worst
-                        && !is_pinned(&parts[j].tris, parts[j].dev)
+                    let (a, b) = split(s, f, p, opts, &both, worst)?;
+                    let ok = !is_pinned(&parts[j].tris, parts[j].dev)
                         && !is_pinned(&a.tris, a.dev)
                         && !is_pinned(&b.tris, b.dev)
                         && lift(s, &a.hull, &a.tris) <= top(w, j)
