@@ -153,8 +153,23 @@ impl Surface {
     /// `is_inside`, which comes with the projection). Every point counts on a surface that is
     /// not [`Surface::sided`], and for `seam < 0` ([`Surface::max_distance`]).
     pub fn max_distance_seams<'a>(&self, pts: impl IntoIterator<Item = &'a P3>, seam: f64) -> f64 {
+        self.max_distance_until(pts, seam, f64::INFINITY)
+    }
+
+    /// [`Surface::max_distance_seams`], but stopped at the first point found `stop` or more
+    /// from the surface: the result is then that point's distance, not the maximum. Below
+    /// `stop`, it is the maximum.
+    pub fn max_distance_until<'a>(
+        &self,
+        pts: impl IntoIterator<Item = &'a P3>,
+        seam: f64,
+        stop: f64,
+    ) -> f64 {
         let mut m: f64 = 0.0;
         for p in pts {
+            if m >= stop {
+                break;
+            }
             if !(m > 0.0 && self.within(p, m * (1.0 - WITHIN_MARGIN))) {
                 let q = to_dvec(p);
                 let proj = self.tri.project_point(&Pose::identity(), q, false);

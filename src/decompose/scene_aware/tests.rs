@@ -804,6 +804,16 @@ fn surface_distance_queries_agree_with_parry() {
     assert!(max > 0.05 * s.diag, "points reach out: {max}");
     assert_eq!(s.max_distance(&pts), max);
     assert_eq!(s.max_distance(pts.iter().rev()), max);
+    // Stopped early: exact when nothing reaches `stop`; else the first point at least that far.
+    assert_eq!(s.max_distance_until(&pts, -1.0, max * (1.0 + 1e-9)), max);
+    for stop in [0.5 * max, 0.9 * max, max] {
+        let first = all
+            .iter()
+            .copied()
+            .find(|&d| d >= stop)
+            .expect("max reaches it");
+        assert_eq!(s.max_distance_until(&pts, -1.0, stop), first, "stop {stop}");
+    }
 }
 
 #[test]
