@@ -52,6 +52,7 @@ use super::{build_part, hulls_of, metrics, split_candidates, Params, Part, CONTA
 use crate::decompose::{DecomposeOptions, Hull};
 use rayon::prelude::*;
 use std::collections::BTreeMap;
+use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::{Arc, OnceLock};
 
 /// Consecutive hulls that no move improved after which the polishing stops. Past three, a
@@ -131,14 +132,41 @@ impl Samples {
 
     /// Area of the visible surface farther than `thr` from the mesh.
     fn excess(&self, s: &Surface, all: &[&Hull], skip: &[usize], eps: f64, thr: f64) -> f64 {
-        let far = (0..self.pts.len())
-            .filter(|&k| self.is_visible(k, all, skip, eps))
-            .filter(|&k| match self.dist.get() {
+        self.excess_while(s, all, skip, eps, thr, 0.0, &|_| true)
+            .expect("always kept")
+    }
+
+    /// [`Samples::excess`], or `None` as soon as `base` plus the excess counted so far fails
+    /// `ok` (which must then fail for anything larger: the count only grows).
+    #[allow(clippy::too_many_arguments)]
+    fn excess_while(
+        &self,
+        s: &Surface,
+        all: &[&Hull],
+        skip: &[usize],
+        eps: f64,
+        thr: f64,
+        base: f64,
+        ok: &dyn Fn(f64) -> bool,
+    ) -> Option<f64> {
+        let n = self.pts.len() as f64;
+        let mut far = 0usize;
+        for k in 0..self.pts.len() {
+            if !self.is_visible(k, all, skip, eps) {
+                continue;
+            }
+            let is_far = match self.dist.get() {
                 Some(d) => d[k] > thr,
                 None => s.farther(&self.pts[k], thr),
-            })
-            .count();
-        self.area * far as f64 / self.pts.len() as f64
+            };
+            if is_far {
+                far += 1;
+                if !ok(base + self.area * far as f64 / n) {
+                    return None;
+                }
+            }
+        }
+        Some(self.area * far as f64 / n)
     }
 }
 
@@ -220,7 +248,13 @@ pub(super) fn polish(
         let top = |i: usize, j: usize| lifts[i].max(lifts[j]).max(CONTACT_DEV * p.tol);
         // Of the ways to split in two, the one leaving least excess, with the other hulls but
         // `skip`.
-        let best_halves = |cands: Vec<(Part, Part)>, skip: &[usize], limit: f64| {
+        // `accept`: whether a split leaving that much excess would be kept (false for all
+        // above one it is false for). The others are left out as soon as their excess counted
+        // so far fails it, or exceeds the least found so far.
+        let best_halves = |cands: Vec<(Part, Part)>,
+                           skip: &[usize],
+                           limit: f64,
+                           accept: &(dyn Fn(f64) -> bool + Sync)| {
             let mut cands: Vec<(usize, (Part, Part))> = cands
                 .into_iter()
                 .enumerate()
@@ -239,18 +273,22 @@ pub(super) fn polish(
                     .then(i.cmp(j))
             });
             cands.truncate(SHORTLIST);
+            // The least excess found so far, as bits (excess ≥ 0: ordered as the values).
+            let least = AtomicU64::new(f64::INFINITY.to_bits());
+            let ok = |e: f64| e <= f64::from_bits(least.load(Ordering::Relaxed)) && accept(e);
             cands
                 .into_par_iter()
-                .map(|(k, (a, b))| {
+                .filter_map(|(k, (a, b))| {
                     let (a, b) = (sampled(a), sampled(b));
                     let n = hulls.len();
                     let mut hs: Vec<&Hull> = hulls.clone();
                     hs.extend([&a.0.hull, &b.0.hull]);
                     let skip_a: Vec<usize> = skip.iter().copied().chain([n]).collect();
                     let skip_b: Vec<usize> = skip.iter().copied().chain([n + 1]).collect();
-                    let e = a.1.excess(s, &hs, &skip_a, eps, thr)
-                        + b.1.excess(s, &hs, &skip_b, eps, thr);
-                    (e, k, a, b)
+                    let ea = a.1.excess_while(s, &hs, &skip_a, eps, thr, 0.0, &ok)?;
+                    let e = ea + b.1.excess_while(s, &hs, &skip_b, eps, thr, ea, &ok)?;
+                    least.fetch_min(e.to_bits(), Ordering::Relaxed);
+                    Some((e, k, a, b))
                 })
                 .min_by(|x, y| x.0.total_cmp(&y.0).then(x.1.cmp(&y.1)))
         };
@@ -293,12 +331,14 @@ pub(super) fn polish(
         let mut trial: Vec<(usize, Sampled)> = Vec::new();
         if let Some((added, i, j)) = merge {
             let limit = lifts[w].max(CONTACT_DEV * p.tol);
+            let kept = |e: f64| e + added < ex[w];
             if let Some((e, _, a, b)) = best_halves(
                 split_candidates(s, f, p, opts, &parts[w], true, f64::INFINITY),
                 &[w],
                 limit,
+                &kept,
             ) {
-                if e + added < ex[w] {
+                if kept(e) {
                     let m = merged[&(ids[i], ids[j])].clone().expect("merge was built");
                     trial = vec![(i, m), (w, a), (j, b)];
                 }
@@ -326,12 +366,14 @@ pub(super) fn polish(
                         tris: union(&parts[w], &parts[j]),
                         ..parts[w].clone()
                     };
+                    let kept = |e: f64| e < ex[w] + ex[j];
                     let (e, _, a, b) = best_halves(
                         split_candidates(s, f, p, opts, &both, true, f64::INFINITY),
                         &[w, j],
                         top(w, j),
+                        &kept,
                     )?;
-                    (e < ex[w] + ex[j]).then_some((e - ex[w] - ex[j], j, a, b))
+                    kept(e).then_some((e - ex[w] - ex[j], j, a, b))
                 })
                 .min_by(|x, y| x.0.total_cmp(&y.0).then(x.1.cmp(&y.1)));
             if let Some((_, j, a, b)) = best {
