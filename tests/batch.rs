@@ -5,7 +5,7 @@
 mod batch_data;
 mod common;
 
-use batch_data::{make_dataset, snapshot, Made, Spec};
+use batch_data::{make_dataset, Made, Spec};
 use common::*;
 use serde_json::Value;
 use std::path::Path;

@@ -254,27 +254,3 @@ fn write_manifest(dir: &Path, rel: &str, s: &TwoObjects) {
     )
     .unwrap();
 }
-
-/// Every file under `dir` as (relative path, bytes), sorted.
-pub fn snapshot(dir: &Path) -> Vec<(String, Vec<u8>)> {
-    let mut v = Vec::new();
-    let mut stack = vec![dir.to_path_buf()];
-    while let Some(p) = stack.pop() {
-        for e in fs::read_dir(&p).unwrap() {
-            let e = e.unwrap().path();
-            if e.is_dir() {
-                stack.push(e);
-            } else {
-                v.push((
-                    e.strip_prefix(dir)
-                        .unwrap()
-                        .to_string_lossy()
-                        .replace('\\', "/"),
-                    fs::read(&e).unwrap(),
-                ));
-            }
-        }
-    }
-    v.sort();
-    v
-}

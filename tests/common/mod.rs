@@ -163,7 +163,8 @@ pub fn rejects_with(scene: &Path, extra: &[&str], culprit: &str, problem: &str) 
     }
 }
 
-/// Every file under `dir` (links not followed) with its bytes, sorted.
+/// Every file under `dir` (links not followed, a link's bytes are its target) as (path
+/// relative to `dir`, '/'-separated, bytes), sorted.
 pub fn snapshot(dir: &Path) -> Vec<(String, Vec<u8>)> {
     let mut v: Vec<_> = walk(dir)
         .into_iter()
@@ -177,7 +178,12 @@ pub fn snapshot(dir: &Path) -> Vec<(String, Vec<u8>)> {
             } else {
                 fs::read(&p).unwrap()
             };
-            (p.display().to_string(), bytes)
+            let rel = p
+                .strip_prefix(dir)
+                .unwrap()
+                .to_string_lossy()
+                .replace('\\', "/");
+            (rel, bytes)
         })
         .collect();
     v.sort();
