@@ -359,6 +359,9 @@ pub(super) fn polish(
                 .collect();
             nb.sort_by(|&a, &b| ex[b].total_cmp(&ex[a]).then(a.cmp(&b)));
             nb.truncate(NEIGHBOURS);
+            // The least change of excess a neighbour's move gives so far: another neighbour's
+            // split that cannot beat it is left out early, like a worse way to split.
+            let least = std::sync::Mutex::new(f64::INFINITY);
             let best = nb
                 .par_iter()
                 .filter_map(|&j| {
@@ -366,14 +369,22 @@ pub(super) fn polish(
                         tris: union(&parts[w], &parts[j]),
                         ..parts[w].clone()
                     };
-                    let kept = |e: f64| e < ex[w] + ex[j];
+                    let gain = |e: f64| e - ex[w] - ex[j];
+                    let kept = |e: f64| {
+                        e < ex[w] + ex[j] && gain(e) <= *least.lock().expect("no panic holding it")
+                    };
                     let (e, _, a, b) = best_halves(
                         split_candidates(s, f, p, opts, &both, true, f64::INFINITY),
                         &[w, j],
                         top(w, j),
                         &kept,
                     )?;
-                    kept(e).then_some((e - ex[w] - ex[j], j, a, b))
+                    if !kept(e) {
+                        return None;
+                    }
+                    let mut l = least.lock().expect("no panic holding it");
+                    *l = l.min(gain(e));
+                    Some((gain(e), j, a, b))
                 })
                 .min_by(|x, y| x.0.total_cmp(&y.0).then(x.1.cmp(&y.1)));
             if let Some((_, j, a, b)) = best {
