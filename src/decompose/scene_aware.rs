@@ -483,7 +483,7 @@ fn deviation_until(
         .iter()
         .filter(|v| !on_mesh.contains(v))
         .chain(&samples);
-    // No seams: every point counts (see `Surface::max_distance_seams`).
+    // No seams: every point counts (see `Surface::max_distance_until`).
     s.max_distance_until(pts, seams.unwrap_or(-1.0), stop)
 }
 

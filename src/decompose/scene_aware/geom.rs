@@ -23,7 +23,7 @@ pub struct Surface {
     /// Closed, or nearly so: no hole, facing out, with at most one directed edge in a
     /// thousand used twice (scans where more than two triangles meet on an edge). The side of
     /// the surface a point is on, by the nearest feature's pseudo-normal, is then meaningful
-    /// but next to those few edges ([`Surface::max_distance_seams`]). Not for a mesh with
+    /// but next to those few edges ([`Surface::max_distance_until`]). Not for a mesh with
     /// holes: near a hole's rim the nearest feature's side says nothing about the point.
     pub sided: bool,
     pub aabb: Aabb,
@@ -145,20 +145,15 @@ impl Surface {
     /// The largest [`Surface::distance`] of `pts`, exactly: a point within the largest so far
     /// costs only a [`Surface::within`] test. Pass the points likeliest to be far first.
     pub fn max_distance<'a>(&self, pts: impl IntoIterator<Item = &'a P3>) -> f64 {
-        self.max_distance_seams(pts, -1.0)
+        self.max_distance_until(pts, -1.0, f64::INFINITY)
     }
 
     /// [`Surface::max_distance`] but for the points inside the material within `seam` of the
     /// surface, which are not counted: by the pseudo-normal of the nearest feature (parry's
     /// `is_inside`, which comes with the projection). Every point counts on a surface that is
-    /// not [`Surface::sided`], and for `seam < 0` ([`Surface::max_distance`]).
-    pub fn max_distance_seams<'a>(&self, pts: impl IntoIterator<Item = &'a P3>, seam: f64) -> f64 {
-        self.max_distance_until(pts, seam, f64::INFINITY)
-    }
-
-    /// [`Surface::max_distance_seams`], but stopped at the first point found `stop` or more
-    /// from the surface: the result is then that point's distance, not the maximum. Below
-    /// `stop`, it is the maximum.
+    /// not [`Surface::sided`], and for `seam < 0`. Stopped at the first point found `stop` or
+    /// more from the surface: the result is then that point's distance, not the maximum.
+    /// Below `stop`, it is the maximum.
     pub fn max_distance_until<'a>(
         &self,
         pts: impl IntoIterator<Item = &'a P3>,
