@@ -514,16 +514,19 @@ fn build_part_below(
     bound: f64,
 ) -> Option<Part> {
     let key = Memo::key(&tris, &cuts);
-    match p.memo.get(&key) {
-        Some(Built::Done(part)) => return part.filter(|q| q.dev < bound),
-        Some(Built::Above(dev)) if dev >= bound => return None,
-        _ => {}
-    }
-    let built = match build_new_part(s, p, opts, tris, cuts, bound) {
-        Some(q) if q.dev >= bound => Built::Above(q.dev),
-        part => Built::Done(part),
+    // A part kept "above" a lower bound than this one says nothing here: built again.
+    let built = match p.memo.get(&key) {
+        Some(Built::Above(dev)) if dev < bound => None,
+        known => known,
     };
-    p.memo.put(key, built.clone());
+    let built = built.unwrap_or_else(|| {
+        let b = match build_new_part(s, p, opts, tris, cuts, bound) {
+            Some(q) if q.dev >= bound => Built::Above(q.dev),
+            part => Built::Done(part),
+        };
+        p.memo.put(key, b.clone());
+        b
+    });
     match built {
         Built::Done(part) => part.filter(|q| q.dev < bound),
         Built::Above(_) => None,
