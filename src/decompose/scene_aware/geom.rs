@@ -549,6 +549,7 @@ pub fn star_pieces(
         }
     }
     let mut assigned = vec![false; nt];
+    let mut queued = vec![false; nt];
     let mut pieces = Vec::new();
     for seed in 0..nt {
         if assigned[seed] {
@@ -557,45 +558,32 @@ pub fn star_pieces(
         if pieces.len() == max_pieces {
             return None;
         }
-        let mut verts: Vec<u32> = Vec::with_capacity(cap);
-        let mut faces = Vec::new();
-        let mut queue = std::collections::VecDeque::from([seed]);
-        let mut queued = vec![false; nt];
-        queued[seed] = true;
-        while let Some(f) = queue.pop_front() {
-            let new: Vec<u32> = triangles[f]
-                .iter()
-                .copied()
-                .filter(|v| !verts.contains(v))
-                .collect();
-            if verts.len() + new.len() > cap {
-                continue;
-            }
-            if bulge.is_finite() && !new.is_empty() && !verts.is_empty() {
-                let mut pts: Vec<P3> = verts
-                    .iter()
-                    .chain(&new)
-                    .map(|&i| vertices[i as usize])
-                    .collect();
+        let mut g = Growth {
+            verts: Vec::with_capacity(cap),
+            faces: Vec::new(),
+            queue: std::collections::VecDeque::from([seed]),
+            queued: vec![seed],
+            assigned: &mut assigned,
+            queued_mark: &mut queued,
+        };
+        g.queued_mark[seed] = true;
+        if bulge.is_finite() {
+            g.grow_checked(triangles, &adj, cap, |verts| {
+                let mut pts: Vec<P3> = verts.iter().map(|&i| vertices[i as usize]).collect();
                 pts.push(*c);
-                let deep = Hull::from_points(&pts).is_none_or(|h| {
-                    pts[..pts.len() - 1]
-                        .iter()
-                        .any(|v| depth_under(&h, c, v) > bulge)
-                });
-                if deep {
-                    continue;
-                }
-            }
-            verts.extend(new);
-            assigned[f] = true;
-            faces.push(f);
-            for &g in &adj[f] {
-                if !assigned[g] && !queued[g] {
-                    queued[g] = true;
-                    queue.push_back(g);
-                }
-            }
+                let h = Hull::from_points(&pts)?;
+                let ok = pts[..pts.len() - 1]
+                    .iter()
+                    .all(|v| depth_under(&h, c, v) <= bulge);
+                Some((ok, h.volume, h.aabb.diagonal()))
+            });
+        } else {
+            g.grow(triangles, &adj, cap, None);
+        }
+        let faces = std::mem::take(&mut g.faces);
+        let verts = std::mem::take(&mut g.verts);
+        for &f in &g.queued {
+            queued[f] = false;
         }
         let mut normal = V3::zeros();
         for &f in &faces {
@@ -633,6 +621,135 @@ fn depth_under(h: &Hull, c: &P3, v: &P3) -> f64 {
         0.0
     }
 }
+
+/// One star piece's patch as it grows (see [`star_pieces`]): breadth first from its seed, a
+/// face joining when its new vertices fit in `cap` and, if checked, the cone over the patch
+/// then bulges no more than allowed.
+struct Growth<'a> {
+    verts: Vec<u32>,
+    faces: Vec<usize>,
+    queue: std::collections::VecDeque<usize>,
+    /// Faces queued for this patch (their marks are cleared when it is done or rolled back).
+    queued: Vec<usize>,
+    assigned: &'a mut [bool],
+    queued_mark: &'a mut [bool],
+}
+
+impl Growth<'_> {
+    /// Grows the patch face by face, a face joining when its new vertices fit in `cap`. With
+    /// `limit = Some((checks, skip))`, the faces that add a vertex to a non-empty patch (the
+    /// ones a cone check is for) are counted: the first `skip` of them are rejected, and the
+    /// growth stops before the one after `checks` have joined. Returns how many joined.
+    fn grow(
+        &mut self,
+        triangles: &[[u32; 3]],
+        adj: &[Vec<usize>],
+        cap: usize,
+        limit: Option<(usize, usize)>,
+    ) -> usize {
+        let (mut joined, mut seen) = (0, 0);
+        while let Some(&f) = self.queue.front() {
+            let new: Vec<u32> = triangles[f]
+                .iter()
+                .copied()
+                .filter(|v| !self.verts.contains(v))
+                .collect();
+            let counted = limit.filter(|_| !new.is_empty() && !self.verts.is_empty());
+            if counted.is_some_and(|(checks, _)| joined == checks) {
+                break;
+            }
+            self.queue.pop_front();
+            if self.verts.len() + new.len() > cap {
+                continue;
+            }
+            if let Some((_, skip)) = counted {
+                seen += 1;
+                if seen <= skip {
+                    continue;
+                }
+                joined += 1;
+            }
+            self.verts.extend(new);
+            self.assigned[f] = true;
+            self.faces.push(f);
+            for &g in &adj[f] {
+                if !self.assigned[g] && !self.queued_mark[g] {
+                    self.queued_mark[g] = true;
+                    self.queued.push(g);
+                    self.queue.push_back(g);
+                }
+            }
+        }
+        joined
+    }
+
+    /// [`Growth::grow`] where a face that adds a vertex to a non-empty patch joins only if the
+    /// cone over the patch with it passes `check` (`Some((passes, volume, diagonal))`; `None`:
+    /// degenerate, fails), with the same result as checking one face at a time. Faces are
+    /// tried in batches: the cone only grows as faces join, and a vertex lies no deeper under
+    /// a smaller cone along its ray, so a batch whose final cone passes would have passed face
+    /// by face. A batch that fails is halved and tried again, a single face that fails is
+    /// rejected. A batch is tried only when the last cone that passed holds more than the
+    /// degenerate volume of the batch's (1e-12 diagonal³, see [`Hull::from_mesh`]), so no
+    /// cone in between could have been degenerate.
+    fn grow_checked(
+        &mut self,
+        triangles: &[[u32; 3]],
+        adj: &[Vec<usize>],
+        cap: usize,
+        check: impl Fn(&[u32]) -> Option<(bool, f64, f64)>,
+    ) {
+        let (mut batch, mut volume) = (1, 0.0f64);
+        loop {
+            let mark = (
+                self.verts.len(),
+                self.faces.len(),
+                self.queued.len(),
+                self.queue.clone(),
+            );
+            let mut skip = 0;
+            loop {
+                let joined = self.grow(triangles, adj, cap, Some((batch, skip)));
+                if joined == 0 {
+                    if skip == 0 {
+                        return;
+                    }
+                    break;
+                }
+                let cone = check(&self.verts)
+                    .filter(|&(ok, _, diag)| ok && (batch == 1 || volume > 1e-12 * diag.powi(3)));
+                if let Some((_, v, _)) = cone {
+                    volume = v;
+                    batch = (batch * 2).min(MAX_BATCH);
+                    break;
+                }
+                self.roll_back(&mark);
+                if batch > 1 {
+                    batch /= 2;
+                } else {
+                    skip += 1;
+                }
+            }
+        }
+    }
+
+    /// Undoes the growth since `mark` (lengths of `verts`, `faces`, `queued`, and the queue).
+    fn roll_back(&mut self, mark: &(usize, usize, usize, std::collections::VecDeque<usize>)) {
+        for &f in &self.faces[mark.1..] {
+            self.assigned[f] = false;
+        }
+        for &f in &self.queued[mark.2..] {
+            self.queued_mark[f] = false;
+        }
+        self.verts.truncate(mark.0);
+        self.faces.truncate(mark.1);
+        self.queued.truncate(mark.2);
+        self.queue.clone_from(&mark.3);
+    }
+}
+
+/// The most faces [`Growth::grow_checked`] tries at once.
+const MAX_BATCH: usize = 64;
 
 /// `n` unit directions spread evenly over the ellipsoid of (orthogonal) semi-axes `axes` (a
 /// Fibonacci lattice on the sphere, stretched), and a triangulation of them (the hull of the

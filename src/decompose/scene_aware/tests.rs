@@ -999,3 +999,99 @@ fn distinct_sorted_is_sort_and_dedup() {
         assert_eq!(geom::distinct_sorted(&v), want, "{n} values below {range}");
     }
 }
+
+/// Star pieces grown in batches of faces (`geom::star_pieces`) are the pieces grown one face at
+/// a time, one cone check per face (the region growing as first written, below), on a bumpy
+/// solid star-shaped about its centre, at bulge limits that reject few to many faces.
+#[test]
+fn star_pieces_in_batches_are_the_face_by_face_growth() {
+    fn face_by_face(v: &[P3], t: &[[u32; 3]], c: &P3, cap: usize, bulge: f64) -> Vec<Vec<u32>> {
+        // Neighbours in the order of the edge they share, as the engine orders them.
+        let mut adj: Vec<Vec<([u32; 2], usize)>> = vec![Vec::new(); t.len()];
+        for (f, a) in t.iter().enumerate() {
+            for (g, b) in t.iter().enumerate() {
+                let shared: Vec<u32> = a.iter().copied().filter(|x| b.contains(x)).collect();
+                if f != g && shared.len() == 2 {
+                    adj[f].push(([shared[0].min(shared[1]), shared[0].max(shared[1])], g));
+                }
+            }
+            adj[f].sort();
+        }
+        // How far `p` lies under the boundary of `h` along the ray from `c`.
+        let depth = |h: &Hull, p: &P3| {
+            let u = (p - c).normalize();
+            let exit = h
+                .planes
+                .iter()
+                .filter(|(n, _)| n.dot(&u) > 1e-12)
+                .map(|(n, d)| (d - n.dot(&c.coords)) / n.dot(&u))
+                .fold(f64::INFINITY, f64::min);
+            exit - (p - c).norm()
+        };
+        let mut assigned = vec![false; t.len()];
+        let mut pieces = Vec::new();
+        for seed in 0..t.len() {
+            if assigned[seed] {
+                continue;
+            }
+            let mut verts: Vec<u32> = Vec::new();
+            let mut queued = vec![false; t.len()];
+            let mut queue = std::collections::VecDeque::from([seed]);
+            queued[seed] = true;
+            while let Some(f) = queue.pop_front() {
+                let new: Vec<u32> = t[f]
+                    .iter()
+                    .copied()
+                    .filter(|x| !verts.contains(x))
+                    .collect();
+                if verts.len() + new.len() > cap {
+                    continue;
+                }
+                if !new.is_empty() && !verts.is_empty() {
+                    let mut pts: Vec<P3> =
+                        verts.iter().chain(&new).map(|&i| v[i as usize]).collect();
+                    pts.push(*c);
+                    let fits = Hull::from_points(&pts).is_some_and(|h| {
+                        pts[..pts.len() - 1].iter().all(|p| depth(&h, p) <= bulge)
+                    });
+                    if !fits {
+                        continue;
+                    }
+                }
+                verts.extend(new);
+                assigned[f] = true;
+                for &(_, g) in &adj[f] {
+                    if !assigned[g] && !queued[g] {
+                        queued[g] = true;
+                        queue.push_back(g);
+                    }
+                }
+            }
+            pieces.push(verts);
+        }
+        pieces
+    }
+    let (dirs, tris) = geom::sphere_directions(600, &[V3::x(), V3::y(), V3::z()]).unwrap();
+    let c = P3::new(0.1, -0.2, 0.3);
+    let verts: Vec<P3> = dirs
+        .iter()
+        .map(|u| c + u * (1.0 + 0.25 * (3.0 * u.x).sin() * (2.0 * u.y).cos() + 0.15 * u.z * u.z))
+        .collect();
+    let mut rejected = 0;
+    for max_vertices in [16, 64] {
+        for bulge in [0.002, 0.01, 0.05, f64::INFINITY] {
+            let want = face_by_face(&verts, &tris, &c, max_vertices - 1, bulge);
+            let got = geom::star_pieces(&verts, &tris, &c, max_vertices, 10_000, bulge).unwrap();
+            let got: Vec<Vec<P3>> = got.into_iter().map(|(_, outer, _)| outer).collect();
+            let want: Vec<Vec<P3>> = want
+                .iter()
+                .map(|p| p.iter().map(|&i| verts[i as usize]).collect())
+                .collect();
+            assert_eq!(got, want, "{max_vertices} vertices, bulge {bulge}");
+            // Tighter bulges take more pieces: faces were rejected.
+            let loose = face_by_face(&verts, &tris, &c, max_vertices - 1, f64::INFINITY).len();
+            rejected += want.len().saturating_sub(loose);
+        }
+    }
+    assert!(rejected > 0, "no bulge limit rejected a face");
+}
