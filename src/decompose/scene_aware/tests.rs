@@ -734,12 +734,14 @@ fn star_pieces_fill_a_dimpled_solid_and_keep_the_dimple_open() {
 }
 
 /// Real solids: the YCB apple, filled by star pieces, where its 32 surface patches kept 24 % of
-/// its volume at p95 3.5 % of the diagonal (measured 0.46 %, volume 1.00); the banana, which
+/// its volume at p95 3.5 % of the diagonal (measured 0.46 %, volume 1.00); the pear, whose star
+/// pieces are within the tolerance (0.49 %) and kept without V-HACD, although V-HACD's hulls
+/// lie closer (0.28 %; CoACD 32×64: 1.80 %); the banana, which
 /// its centre does not see whole, by V-HACD's hulls, where its patches kept 36 % of its
 /// volume at p95 1.64 % (measured 0.19 %, volume 1.01, 2 % of its surface uncovered; 19 % when
 /// the hulls were brought to 64 vertices by farthest-point sampling, see `voxel_parts`).
 #[test]
-fn real_solids_are_filled_star_pieces_for_an_apple_voxels_for_a_banana() {
+fn real_solids_are_filled_star_pieces_for_an_apple_and_a_pear_voxels_for_a_banana() {
     let Some(sh) = shared() else {
         eprintln!("shared datasets not present: skipped");
         return;
@@ -758,6 +760,14 @@ fn real_solids_are_filled_star_pieces_for_an_apple_voxels_for_a_banana() {
     let q = metrics::measure(&apple, &hulls[0]);
     eprintln!("apple: {q:?}");
     assert!(q.dist_p95 <= 0.006, "{q:?}");
+    assert!(q.volume_ratio >= 0.95, "{q:?}");
+    let pear = load("016_pear/textured.obj");
+    let (hulls, rep) = decompose_scene(&[&pear], &o);
+    assert!(rep.objects[0].star_pieces && !rep.objects[0].voxel_hulls);
+    assert_limits(&hulls[0], &o);
+    let q = metrics::measure(&pear, &hulls[0]);
+    eprintln!("pear: {q:?}");
+    assert!(q.dist_p95 <= o.tolerance, "{q:?}");
     assert!(q.volume_ratio >= 0.95, "{q:?}");
     let banana = load("011_banana/textured.obj");
     let (hulls, rep) = decompose_scene(&[&banana], &o);
