@@ -1011,7 +1011,8 @@ fn distinct_sorted_is_sort_and_dedup() {
 }
 
 /// Star pieces grown in batches of faces (`geom::star_pieces`) are the pieces grown one face at
-/// a time, one cone check per face (the region growing as first written, below), on a bumpy
+/// a time, one cone check per face (the region growing as first written, below, with the
+/// engine's own depth test), on a bumpy
 /// solid star-shaped about its centre, at bulge limits that reject few to many faces.
 #[test]
 fn star_pieces_in_batches_are_the_face_by_face_growth() {
@@ -1027,17 +1028,6 @@ fn star_pieces_in_batches_are_the_face_by_face_growth() {
             }
             adj[f].sort();
         }
-        // How far `p` lies under the boundary of `h` along the ray from `c`.
-        let depth = |h: &Hull, p: &P3| {
-            let u = (p - c).normalize();
-            let exit = h
-                .planes
-                .iter()
-                .filter(|(n, _)| n.dot(&u) > 1e-12)
-                .map(|(n, d)| (d - n.dot(&c.coords)) / n.dot(&u))
-                .fold(f64::INFINITY, f64::min);
-            exit - (p - c).norm()
-        };
         let mut assigned = vec![false; t.len()];
         let mut pieces = Vec::new();
         for seed in 0..t.len() {
@@ -1062,7 +1052,9 @@ fn star_pieces_in_batches_are_the_face_by_face_growth() {
                         verts.iter().chain(&new).map(|&i| v[i as usize]).collect();
                     pts.push(*c);
                     let fits = Hull::from_points(&pts).is_some_and(|h| {
-                        pts[..pts.len() - 1].iter().all(|p| depth(&h, p) <= bulge)
+                        pts[..pts.len() - 1]
+                            .iter()
+                            .all(|p| geom::depth_under(&h, c, p) <= bulge)
                     });
                     if !fits {
                         continue;
