@@ -969,12 +969,7 @@ fn convex_components(s: &Surface, opts: &DecomposeOptions, budget: usize) -> (Ve
         .collect::<Vec<_>>()
         .par_iter()
         .map(|tris| {
-            let vs = distinct_sorted(
-                &tris
-                    .iter()
-                    .flat_map(|&t| s.mesh.triangles[t as usize])
-                    .collect::<Vec<_>>(),
-            );
+            let vs = s.vertices_of(tris);
             let pts: Vec<P3> = vs.iter().map(|&v| s.mesh.vertices[v as usize]).collect();
             let local = |v: u32| vs.binary_search(&v).unwrap_or(0) as u32;
             let m = Mesh::new(
@@ -1225,7 +1220,11 @@ fn decompose_object(
     // bottle it took 0.26 s of the 0.33 s, for p95 0.65 % where the star pieces read 0.77 %
     // (CoACD 32×64: 4.52 %).
     let mut whole: Vec<(f64, Vec<Part>, Solid)> = Vec::new();
-    let supports = |q: &Vec<Part>| keeps_support(s, &p, opts, near, q);
+    // A candidate, when it keeps what a neighbour may rest on.
+    let candidate = |c: Option<(f64, Vec<Part>)>, kind: Solid| {
+        c.filter(|(_, q)| keeps_support(s, &p, opts, near, q))
+            .map(|(d, q)| (d, q, kind))
+    };
     // The closest whose hulls reach at most `bound` past the surface anywhere: V-HACD's hulls
     // of the YCB pear were closer than its star pieces at the 95th percentile (0.47 against
     // 0.49 % of the diagonal) but one reached 7.1 % past it. Alone within the tolerance, 5
@@ -1241,18 +1240,10 @@ fn decompose_object(
     let within = |w: &[(f64, Vec<Part>, Solid)]| {
         closest(w, 5.0 * p.tol).filter(|&k| w[k].0 <= opts.tolerance)
     };
-    whole.extend(
-        star(s, &p, opts, budget)
-            .filter(|(_, q)| supports(q))
-            .map(|(d, q)| (d, q, Solid::Star)),
-    );
+    whole.extend(candidate(star(s, &p, opts, budget), Solid::Star));
     let thick = thick_solid(s);
     if thick && within(&whole).is_none() {
-        whole.extend(
-            voxel_parts(s, opts, budget)
-                .filter(|(_, q)| supports(q))
-                .map(|(d, q)| (d, q, Solid::Voxel)),
-        );
+        whole.extend(candidate(voxel_parts(s, opts, budget), Solid::Voxel));
     }
     if let Some(k) = within(&whole) {
         let (_, parts, kind) = whole.swap_remove(k);
@@ -1288,11 +1279,7 @@ fn decompose_object(
     // thickness test missed shows as patches that leave it hollow: V-HACD then too.
     let (d_parts, reach) = dist.unwrap_or((0.0, 0.0));
     if !thick && d_parts > opts.tolerance && hollow(s, &parts) {
-        whole.extend(
-            voxel_parts(s, opts, budget)
-                .filter(|(_, q)| supports(q))
-                .map(|(d, q)| (d, q, Solid::Voxel)),
-        );
+        whole.extend(candidate(voxel_parts(s, opts, budget), Solid::Voxel));
     }
     if let Some(k) = closest(&whole, (5.0 * p.tol).max(reach * s.diag)) {
         if whole[k].0 < d_parts {

@@ -220,6 +220,15 @@ impl Surface {
 }
 
 impl Surface {
+    /// The mesh vertices of triangles `tris`, each once, ascending.
+    pub fn vertices_of(&self, tris: &[u32]) -> Vec<u32> {
+        let v: Vec<u32> = tris
+            .iter()
+            .flat_map(|&t| self.mesh.triangles[t as usize])
+            .collect();
+        distinct_sorted(&v)
+    }
+
     /// `n` points on the whole surface, stratified by area (see [`sample_triangles`]).
     pub fn samples(&self, n: usize, seed: u64) -> Vec<P3> {
         let tris: Vec<[P3; 3]> = (0..self.mesh.triangles.len())
@@ -580,11 +589,7 @@ pub fn star_pieces(
         } else {
             g.grow(triangles, &adj, cap, None);
         }
-        let faces = std::mem::take(&mut g.faces);
-        let verts = std::mem::take(&mut g.verts);
-        for &f in &g.queued {
-            queued[f] = false;
-        }
+        let (faces, verts) = g.finish();
         let mut normal = V3::zeros();
         for &f in &faces {
             let [a, b, d] = triangles[f].map(|i| vertices[i as usize]);
@@ -731,6 +736,14 @@ impl Growth<'_> {
                 }
             }
         }
+    }
+
+    /// The patch's faces and vertices; the queue marks are cleared for the next patch.
+    fn finish(self) -> (Vec<usize>, Vec<u32>) {
+        for &f in &self.queued {
+            self.queued_mark[f] = false;
+        }
+        (self.faces, self.verts)
     }
 
     /// Undoes the growth since `mark` (lengths of `verts`, `faces`, `queued`, and the queue).

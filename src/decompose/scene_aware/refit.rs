@@ -26,7 +26,7 @@
 //! patches too: their pushed copies already reach into the material, and rebuilding them
 //! changed nothing measurable.
 
-use super::geom::{distinct_sorted, greedy_hull, Surface};
+use super::geom::{greedy_hull, Surface};
 use super::rebalance::pinned;
 use super::{deviation, Params, Part};
 use crate::decompose::{DecomposeOptions, Hull};
@@ -52,12 +52,7 @@ pub(super) fn refit(
             {
                 return 0;
             }
-            let vs = distinct_sorted(
-                &q.tris
-                    .iter()
-                    .flat_map(|&t| s.mesh.triangles[t as usize])
-                    .collect::<Vec<_>>(),
-            );
+            let vs = s.vertices_of(&q.tris);
             if vs.len() <= q.outer.len() {
                 return 0;
             }
