@@ -77,6 +77,7 @@
 //! fixed order. Cached: see [`super::cache`]; the key covers every object of the scene since
 //! the result depends on the neighbours.
 
+mod cells;
 pub mod geom;
 pub mod metrics;
 pub mod patches;

@@ -2,6 +2,7 @@
 //! `TriMesh` for distances, inside tests and ray casts), deterministic surface sampling, plane
 //! clipping of hulls and parry conversions.
 
+use super::cells::Cells;
 use crate::decompose::Hull;
 use crate::mesh::{to_dvec, triangle_area, Aabb, Mesh, P3, V3};
 use crate::rng::Rng;
@@ -18,6 +19,8 @@ pub struct Surface {
     pub tri: TriMesh,
     /// The corners of `tri`'s triangles, by its BVH's leaf index (see [`Surface::within`]).
     corners: Vec<[Vector; 3]>,
+    /// Those triangles by grid cell: a first guess for [`Surface::within`].
+    cells: Cells,
     /// Watertight and consistently oriented: inside tests are meaningful.
     pub closed: bool,
     /// Closed, or nearly so: no hole, facing out, with at most one directed edge in a
@@ -62,7 +65,8 @@ impl Surface {
                 let t = tri.triangle(i);
                 [t.a, t.b, t.c]
             })
-            .collect();
+            .collect::<Vec<_>>();
+        let cells = Cells::new(&corners, to_dvec(&aabb.min), to_dvec(&aabb.max));
         let n = mesh.triangles.len();
         let mut tri_normal = Vec::with_capacity(n);
         let mut tri_area = Vec::with_capacity(n);
@@ -91,6 +95,7 @@ impl Surface {
             mesh,
             tri,
             corners,
+            cells,
             closed,
             sided,
             aabb,
@@ -108,23 +113,33 @@ impl Surface {
         (proj.point - q).length()
     }
 
-    /// Whether some point of the surface is within `r` of `p`: a depth-first descent of the
-    /// BVH of `tri` that stops at the first triangle found, with squared distances to the
-    /// triangles ([`point_triangle_dist2`]); a third of the cost of a [`Surface::distance`]
-    /// when one is near. It agrees with `distance(p) <= r` but within rounding (1e-15 of the
+    /// Whether some point of the surface is within `r` of `p`: the triangles of `p`'s grid
+    /// cell (see [`Cells`]), then a depth-first descent of the BVH of `tri` that stops at the
+    /// first triangle found, with squared distances to the triangles
+    /// ([`point_triangle_dist2`]); a third of the cost of a [`Surface::distance`] when one is
+    /// near. The cell answers most questions of the engine, which are about points near the
+    /// surface: with it the GSO mug's decomposition ran 5.7 % fewer instructions, for the
+    /// same answers. It agrees with `distance(p) <= r` but within rounding (1e-15 of the
     /// distance), so the tests that must give what `distance` gives ([`Surface::farther`],
     /// [`Surface::max_distance`]) ask it with a margin.
     pub fn within(&self, p: &P3, r: f64) -> bool {
         let q = to_dvec(p);
         let r2 = r * r;
+        let near = |i: u32| {
+            let [a, b, c] = self.corners[i as usize];
+            point_triangle_dist2(q, a, b, c) <= r2
+        };
+        // Most points asked about are near the surface: a triangle of their cell answers.
+        if self.cells.near(q).iter().any(|&i| near(i)) {
+            return true;
+        }
         let mut found = false;
         self.tri.bvh().traverse(|node| {
             if aabb_dist2(node, q) > r2 {
                 return TraversalAction::Prune;
             }
             if let Some(i) = node.leaf_data() {
-                let [a, b, c] = self.corners[i as usize];
-                if point_triangle_dist2(q, a, b, c) <= r2 {
+                if near(i) {
                     found = true;
                     return TraversalAction::EarlyExit;
                 }
