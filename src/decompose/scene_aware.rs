@@ -1017,9 +1017,9 @@ fn convex_components(s: &Surface, opts: &DecomposeOptions, budget: usize) -> (Ve
 }
 
 /// Split a part's patch in two; `None` when it cannot be split, or no split keeps both halves
-/// below `bound` (∞: any split). Of the candidate splits (see [`split_candidates`]) the one
-/// whose worse half deviates least is kept: a concave patch is thus cut across its most
-/// curved direction, which halves its sagitta fastest.
+/// below `bound` (∞: any split). Of the ways to split (see [`split_ways`]) the one whose worse
+/// half deviates least is kept: a concave patch is thus cut across its most curved direction,
+/// which halves its sagitta fastest.
 fn split(
     s: &Surface,
     f: &patches::Features,
@@ -1028,38 +1028,84 @@ fn split(
     part: &Part,
     bound: f64,
 ) -> Option<(Part, Part)> {
-    split_candidates(s, f, p, opts, part, false, bound)
-        .into_iter()
-        .enumerate()
-        .min_by(|(i, x), (j, y)| {
-            x.0.dev
-                .max(x.1.dev)
-                .total_cmp(&y.0.dev.max(y.1.dev))
-                .then(i.cmp(j))
-        })
-        .map(|(_, x)| x)
+    let ways = split_ways(s, f, p, part, false);
+    let mut best = closest_splits(s, p, opts, part, ways, bound, 1, &|_, _| true);
+    best.pop().map(|(_, x)| x)
 }
 
-/// The ways of splitting a part's patch in two, built, in a fixed order: 2-means in feature
-/// space, area-median cuts across the two main axes of the patch (PCA of the mid-wall
-/// positions), and for [`Strategy::Planes`] cuts by planes normal to the scene axes. `fine`
-/// (the polishing) adds cuts at a quarter and three quarters of the area along the principal
-/// axes, and the plane cuts whatever the strategy.
+/// Of the ways of splitting `part` in two (see [`split_ways`]) whose halves both deviate less
+/// than `bound` and that `admit` takes, the `keep` whose worse half deviates least, closest
+/// first (ties: the earlier way), each with its index among the ways.
 ///
-/// A candidate with a half deviating `bound` or more is left out, and its other half is not
-/// built: the rebalancing keeps a split only below the deviation it replaces, and most of the
-/// splits it tries fail (on the sneaker, 4,800 of the top-down strategy's 5,500 builds were the
-/// rebalancing's before this bound; the sneaker took 2.15 → 1.93 s with it).
+/// A way is built below the bound and, once `keep` admitted ways are built, below the `keep`-th
+/// least deviation found so far (strictly above it, so that ties still go to the earlier way):
+/// a half that deviates more is measured only until it passes that (see [`deviation_until`]),
+/// and the other half is not built. The result is that of building every way in full. The
+/// rebalancing keeps a split only below the deviation it replaces, and most of the ways it
+/// tries fail (on the sneaker, 4,800 of the top-down strategy's 5,500 builds were the
+/// rebalancing's before that bound; the sneaker took 2.15 → 1.93 s with it); the quality
+/// loop's splits (`keep` 1) and the polishing's shortlists (see `polish.rs`) then need only
+/// the closest.
 #[allow(clippy::too_many_arguments)]
-fn split_candidates(
+fn closest_splits(
     s: &Surface,
-    f: &patches::Features,
     p: &Params,
     opts: &DecomposeOptions,
     part: &Part,
-    fine: bool,
+    ways: Vec<(Vec<u32>, Vec<u32>)>,
     bound: f64,
-) -> Vec<(Part, Part)> {
+    keep: usize,
+    admit: &(dyn Fn(&Part, &Part) -> bool + Sync),
+) -> Vec<(usize, (Part, Part))> {
+    // The worse halves' deviations of the admitted ways built so far.
+    let found = Mutex::new(Vec::<f64>::new());
+    let below = || {
+        let mut v = found.lock().expect("no panic holding it").clone();
+        if keep == 0 || v.len() < keep {
+            return bound;
+        }
+        let (_, kth, _) = v.select_nth_unstable_by(keep - 1, f64::total_cmp);
+        bound.min(kth.next_up())
+    };
+    let mut built: Vec<(usize, (Part, Part))> = ways
+        .into_par_iter()
+        .enumerate()
+        .filter_map(|(k, (a, b))| {
+            let half = |t| build_part_below(s, p, opts, t, part.cuts.clone(), below());
+            let pa = half(a)?;
+            let pb = half(b)?;
+            if !admit(&pa, &pb) {
+                return None;
+            }
+            found
+                .lock()
+                .expect("no panic holding it")
+                .push(pa.dev.max(pb.dev));
+            Some((k, (pa, pb)))
+        })
+        .collect();
+    built.sort_by(|(i, x), (j, y)| {
+        x.0.dev
+            .max(x.1.dev)
+            .total_cmp(&y.0.dev.max(y.1.dev))
+            .then(i.cmp(j))
+    });
+    built.truncate(keep);
+    built
+}
+
+/// The ways of splitting a part's patch in two, in a fixed order: 2-means in feature space,
+/// area-median cuts across the two main axes of the patch (PCA of the mid-wall positions), and
+/// for [`Strategy::Planes`] cuts by planes normal to the scene axes. `fine` (the polishing)
+/// adds cuts at a quarter and three quarters of the area along the principal axes, and the
+/// plane cuts whatever the strategy.
+fn split_ways(
+    s: &Surface,
+    f: &patches::Features,
+    p: &Params,
+    part: &Part,
+    fine: bool,
+) -> Vec<(Vec<u32>, Vec<u32>)> {
     if part.tris.len() < 2 {
         return Vec::new();
     }
@@ -1133,21 +1179,7 @@ fn split_candidates(
             }
         }
     }
-    let built: Vec<Option<(Part, Part)>> = cands
-        .into_par_iter()
-        .map(|(a, b)| {
-            let half = |t| build_part_below(s, p, opts, t, part.cuts.clone(), bound);
-            if bound.is_finite() {
-                let pa = half(a)?;
-                let pb = half(b)?;
-                Some((pa, pb))
-            } else {
-                let (pa, pb) = rayon::join(|| half(a), || half(b));
-                Some((pa?, pb?))
-            }
-        })
-        .collect();
-    built.into_iter().flatten().collect()
+    cands
 }
 
 /// Once the budget is spent: most moves kept by the rebalancing (see [`rebalance`]) and by the

@@ -21,7 +21,7 @@
 //!
 //! The ways to split are the quality loop's plus cuts at a quarter and three quarters along
 //! the patch's principal axes and by planes normal to the scene axes (see
-//! `split_candidates`); the 6 whose worse half deviates least have their excess measured.
+//! `split_ways`); the 6 whose worse half deviates least have their excess measured.
 //! A move is kept only when the mean of the farthest tenth of the sampled distances drops by
 //! at least 0.2 %: the hull count stays the same and the measured tail never grows. A hull
 //! that no move improves is set aside; the polishing stops after 3 in a row, after `rounds`
@@ -48,7 +48,7 @@
 use super::geom::{sample_hull, Surface};
 use super::patches::Features;
 use super::rebalance::{adjacency, adjacent_pairs, lift, lifts_by_id, pinned, union};
-use super::{build_part, hulls_of, metrics, split_candidates, Params, Part, CONTACT_DEV};
+use super::{build_part, closest_splits, hulls_of, metrics, split_ways, Params, Part, CONTACT_DEV};
 use crate::decompose::{DecomposeOptions, Hull};
 use crate::mesh::Aabb;
 use rayon::prelude::*;
@@ -272,47 +272,37 @@ pub(super) fn polish(
         // `accept`: whether a split leaving that much excess would be kept (false for all
         // above one it is false for). The others are left out as soon as their excess counted
         // so far fails it, or exceeds the least found so far.
-        let best_halves = |cands: Vec<(Part, Part)>,
-                           skip: &[usize],
-                           limit: f64,
-                           accept: &(dyn Fn(f64) -> bool + Sync)| {
-            let mut cands: Vec<(usize, (Part, Part))> = cands
-                .into_iter()
-                .enumerate()
-                .filter(|(_, (a, b))| {
+        let best_halves =
+            |part: &Part, skip: &[usize], limit: f64, accept: &(dyn Fn(f64) -> bool + Sync)| {
+                // Only the closest few by their worse half's deviation are sampled.
+                let admit = |a: &Part, b: &Part| {
                     lift(s, &a.hull, &a.tris) <= limit
                         && lift(s, &b.hull, &b.tris) <= limit
                         && !is_pinned(a)
                         && !is_pinned(b)
-                })
-                .collect();
-            // Only the closest few by their worse half's deviation are sampled.
-            cands.sort_by(|(i, x), (j, y)| {
-                x.0.dev
-                    .max(x.1.dev)
-                    .total_cmp(&y.0.dev.max(y.1.dev))
-                    .then(i.cmp(j))
-            });
-            cands.truncate(SHORTLIST);
-            // The least excess found so far, as bits (excess ≥ 0: ordered as the values).
-            let least = AtomicU64::new(f64::INFINITY.to_bits());
-            let ok = |e: f64| e <= f64::from_bits(least.load(Ordering::Relaxed)) && accept(e);
-            cands
-                .into_par_iter()
-                .filter_map(|(k, (a, b))| {
-                    let (a, b) = (sampled(a), sampled(b));
-                    let n = hulls.len();
-                    let mut hs: Vec<&Hull> = hulls.clone();
-                    hs.extend([&a.0.hull, &b.0.hull]);
-                    let skip_a: Vec<usize> = skip.iter().copied().chain([n]).collect();
-                    let skip_b: Vec<usize> = skip.iter().copied().chain([n + 1]).collect();
-                    let ea = a.1.excess_while(s, &hs, &skip_a, eps, thr, 0.0, &ok)?;
-                    let e = ea + b.1.excess_while(s, &hs, &skip_b, eps, thr, ea, &ok)?;
-                    least.fetch_min(e.to_bits(), Ordering::Relaxed);
-                    Some((e, k, a, b))
-                })
-                .min_by(|x, y| x.0.total_cmp(&y.0).then(x.1.cmp(&y.1)))
-        };
+                };
+                let ways = split_ways(s, f, p, part, true);
+                let cands =
+                    closest_splits(s, p, opts, part, ways, f64::INFINITY, SHORTLIST, &admit);
+                // The least excess found so far, as bits (excess ≥ 0: ordered as the values).
+                let least = AtomicU64::new(f64::INFINITY.to_bits());
+                let ok = |e: f64| e <= f64::from_bits(least.load(Ordering::Relaxed)) && accept(e);
+                cands
+                    .into_par_iter()
+                    .filter_map(|(k, (a, b))| {
+                        let (a, b) = (sampled(a), sampled(b));
+                        let n = hulls.len();
+                        let mut hs: Vec<&Hull> = hulls.clone();
+                        hs.extend([&a.0.hull, &b.0.hull]);
+                        let skip_a: Vec<usize> = skip.iter().copied().chain([n]).collect();
+                        let skip_b: Vec<usize> = skip.iter().copied().chain([n + 1]).collect();
+                        let ea = a.1.excess_while(s, &hs, &skip_a, eps, thr, 0.0, &ok)?;
+                        let e = ea + b.1.excess_while(s, &hs, &skip_b, eps, thr, ea, &ok)?;
+                        least.fetch_min(e.to_bits(), Ordering::Relaxed);
+                        Some((e, k, a, b))
+                    })
+                    .min_by(|x, y| x.0.total_cmp(&y.0).then(x.1.cmp(&y.1)))
+            };
         // Move 1: the merge adding least excess, w split the way leaving least.
         let pairs: Vec<(usize, usize)> = adjacent_pairs(&adj, w);
         let missing: Vec<(usize, usize)> = pairs
@@ -353,12 +343,7 @@ pub(super) fn polish(
         if let Some((added, i, j)) = merge {
             let limit = lifts[w].max(CONTACT_DEV * p.tol);
             let kept = |e: f64| e + added < ex[w];
-            if let Some((e, _, a, b)) = best_halves(
-                split_candidates(s, f, p, opts, &parts[w], true, f64::INFINITY),
-                &[w],
-                limit,
-                &kept,
-            ) {
+            if let Some((e, _, a, b)) = best_halves(&parts[w], &[w], limit, &kept) {
                 if kept(e) {
                     let m = merged[&(ids[i], ids[j])].clone().expect("merge was built");
                     trial = vec![(i, m), (w, a), (j, b)];
@@ -394,12 +379,7 @@ pub(super) fn polish(
                     let kept = |e: f64| {
                         e < ex[w] + ex[j] && gain(e) <= *least.lock().expect("no panic holding it")
                     };
-                    let (e, _, a, b) = best_halves(
-                        split_candidates(s, f, p, opts, &both, true, f64::INFINITY),
-                        &[w, j],
-                        top(w, j),
-                        &kept,
-                    )?;
+                    let (e, _, a, b) = best_halves(&both, &[w, j], top(w, j), &kept)?;
                     if !kept(e) {
                         return None;
                     }

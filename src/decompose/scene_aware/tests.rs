@@ -1097,3 +1097,65 @@ fn star_pieces_in_batches_are_the_face_by_face_growth() {
     }
     assert!(rejected > 0, "no bulge limit rejected a face");
 }
+
+/// The closest ways to split, built below the bound and the `keep`-th least deviation found
+/// so far, are those of building every way in full, admitting and sorting: on the bowl's
+/// patches, for both sets of ways, several shortlist lengths and bounds.
+#[test]
+fn closest_splits_are_those_of_building_every_way() {
+    let o = opts();
+    let s = Surface::new(&bowl()).unwrap();
+    let p = Params::new(&s, &o, Strategy::Planes);
+    let f = patches::Features::new(&s, p.merge_depth, p.d_max);
+    let all: Vec<u32> = (0..s.mesh.triangles.len() as u32).collect();
+    let admit = |a: &Part, b: &Part| a.tris.len() + 8 >= b.tris.len();
+    let mut compared = 0;
+    for tris in patches::kmeans(&s, &f, &all, 6, p.lambda, 12) {
+        let part = build_part(&s, &p, &o, tris, Vec::new()).unwrap();
+        for fine in [false, true] {
+            // Every way built in full, with a memo of its own.
+            let fresh = Params::new(&s, &o, Strategy::Planes);
+            let full: Vec<(usize, (Part, Part))> = split_ways(&s, &f, &p, &part, fine)
+                .into_iter()
+                .enumerate()
+                .filter_map(|(k, (a, b))| {
+                    let a = build_part(&s, &fresh, &o, a, Vec::new())?;
+                    let b = build_part(&s, &fresh, &o, b, Vec::new())?;
+                    Some((k, (a, b)))
+                })
+                .collect();
+            let mut worse: Vec<f64> = full.iter().map(|(_, (a, b))| a.dev.max(b.dev)).collect();
+            worse.sort_by(f64::total_cmp);
+            let median = worse[worse.len() / 2];
+            for bound in [f64::INFINITY, median] {
+                for keep in [1, 3, 6] {
+                    let mut want: Vec<&(usize, (Part, Part))> = full
+                        .iter()
+                        .filter(|(_, (a, b))| a.dev < bound && b.dev < bound && admit(a, b))
+                        .collect();
+                    want.sort_by(|(i, x), (j, y)| {
+                        x.0.dev
+                            .max(x.1.dev)
+                            .total_cmp(&y.0.dev.max(y.1.dev))
+                            .then(i.cmp(j))
+                    });
+                    want.truncate(keep);
+                    let ways = split_ways(&s, &f, &p, &part, fine);
+                    let got = closest_splits(&s, &p, &o, &part, ways, bound, keep, &admit);
+                    assert_eq!(
+                        got.len(),
+                        want.len(),
+                        "fine {fine} bound {bound} keep {keep}"
+                    );
+                    for ((k, (a, b)), (l, (c, d))) in got.iter().zip(want) {
+                        assert_eq!(k, l);
+                        assert_eq!((a.dev, b.dev), (c.dev, d.dev));
+                        assert_eq!((&a.hull, &b.hull), (&c.hull, &d.hull));
+                    }
+                    compared += got.len();
+                }
+            }
+        }
+    }
+    assert!(compared >= 60, "{compared} splits compared");
+}
