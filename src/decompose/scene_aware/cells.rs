@@ -54,11 +54,12 @@ impl Cells {
         let mut id = 0;
         for a in 0..3 {
             // As in `Grid::cell`, so that a point in a triangle's box finds it.
-            let f = ((p[a] - self.min[a]) / self.h).floor();
+            let f = (p[a] - self.min[a]) / self.h;
             // Also false for NaN.
             if !(f >= 0.0 && f < self.dims[a] as f64) {
                 return &[];
             }
+            // Truncation is the floor here (f ≥ 0), without a call to libm's `floor`.
             id = id * self.dims[a] + f as usize;
         }
         &self.tris[self.start[id] as usize..self.start[id + 1] as usize]
@@ -82,10 +83,11 @@ impl Grid {
         self.dims.iter().fold(1usize, |n, &d| n.saturating_mul(d))
     }
 
-    /// The cell coordinates of `p`, clamped to the grid.
+    /// The cell coordinates of `p`, clamped to the grid (truncation is the floor of the
+    /// non-negative coordinate).
     fn cell(&self, p: Vector) -> [usize; 3] {
         [0, 1, 2].map(|a| {
-            let f = ((p[a] - self.min[a]) / self.h).floor().max(0.0) as usize;
+            let f = ((p[a] - self.min[a]) / self.h).max(0.0) as usize;
             f.min(self.dims[a] - 1)
         })
     }

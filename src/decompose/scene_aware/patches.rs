@@ -51,6 +51,10 @@ fn dist2(f: &Features, t: usize, c: &(P3, Matrix3<f64>, f64), lambda2: f64) -> f
     (f.pos[t] - c.0).norm_squared() + lambda2 * (1.0 - 2.0 * n_m_n + c.2)
 }
 
+/// Fewest triangles a thread takes at a time: the polishing's 2-means of a patch of a few
+/// hundred triangles runs on one, where splitting it cost more than it saved.
+const MIN_LEN: usize = 1024;
+
 fn centre(p: P3, m: Matrix3<f64>) -> (P3, Matrix3<f64>, f64) {
     (p, m, m.norm_squared())
 }
@@ -93,6 +97,7 @@ pub fn kmeans(
     let mut centres = vec![seed(tris[first] as usize)];
     let mut best: Vec<f64> = tris
         .par_iter()
+        .with_min_len(MIN_LEN)
         .map(|&t| dist2(f, t as usize, &centres[0], lambda2))
         .collect();
     while centres.len() < k {
@@ -107,6 +112,7 @@ pub fn kmeans(
         let c = seed(tris[i] as usize);
         best.par_iter_mut()
             .zip(tris.par_iter())
+            .with_min_len(MIN_LEN)
             .for_each(|(b, &u)| {
                 *b = b.min(dist2(f, u as usize, &c, lambda2));
             });
@@ -116,6 +122,7 @@ pub fn kmeans(
     for _ in 0..iters.max(1) {
         let new: Vec<usize> = tris
             .par_iter()
+            .with_min_len(MIN_LEN)
             .map(|&t| {
                 let mut bi = 0;
                 let mut bd = f64::INFINITY;
