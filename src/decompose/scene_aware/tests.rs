@@ -1159,3 +1159,30 @@ fn closest_splits_are_those_of_building_every_way() {
     }
     assert!(compared >= 60, "{compared} splits compared");
 }
+
+/// Two patches are adjacent when they share a mesh vertex: `rebalance::adjacency` against
+/// that definition, pair by pair, on the bowl's k-means patches.
+#[test]
+fn patches_sharing_a_vertex_are_adjacent() {
+    let o = opts();
+    let s = Surface::new(&bowl()).unwrap();
+    let p = Params::new(&s, &o, Strategy::Patches);
+    let f = patches::Features::new(&s, p.merge_depth, p.d_max);
+    let all: Vec<u32> = (0..s.mesh.triangles.len() as u32).collect();
+    let parts: Vec<Part> = patches::kmeans(&s, &f, &all, 12, p.lambda, 12)
+        .into_iter()
+        .map(|tris| build_part(&s, &p, &o, tris, Vec::new()).unwrap())
+        .collect();
+    let verts: Vec<Vec<u32>> = parts.iter().map(|q| s.vertices_of(&q.tris)).collect();
+    let adj = rebalance::adjacency(&s, &parts);
+    let mut pairs = 0;
+    for i in 0..parts.len() {
+        let want: Vec<usize> = (0..parts.len())
+            .filter(|&j| j != i && verts[i].iter().any(|v| verts[j].binary_search(v).is_ok()))
+            .collect();
+        assert_eq!(adj[i], want, "patch {i}");
+        pairs += want.len();
+    }
+    // Every patch of a connected bowl touches another; some vertices are shared by three.
+    assert!(pairs >= 2 * parts.len(), "{pairs}");
+}
