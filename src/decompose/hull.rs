@@ -79,6 +79,13 @@ impl Hull {
             .fold(f64::NEG_INFINITY, f64::max)
     }
 
+    /// `plane_distance(p) <= eps` (for a number `eps`), stopped at the first face plane `p`
+    /// is farther than `eps` from: a point far from the hull is mostly beyond one of the first
+    /// faces tried, where `plane_distance` tries them all.
+    pub fn within_planes(&self, p: &P3, eps: f64) -> bool {
+        !self.planes.iter().any(|(n, d)| n.dot(&p.coords) - d > eps)
+    }
+
     /// The smallest width over face normals: how thin the hull is.
     pub fn thickness(&self) -> f64 {
         self.planes
@@ -241,6 +248,46 @@ mod tests {
         assert!(h.contains(&P3::new(0.0049, 0.0099, 0.0149)));
         assert!(!h.contains(&P3::new(0.0051, 0.0, 0.0)));
         assert!((h.thickness() - 0.01).abs() < 1e-12);
+    }
+
+    #[test]
+    fn within_planes_is_the_plane_distance_test() {
+        // A sharp wedge and a sphere, at points from inside to well outside, with tolerances
+        // of 0 to a tenth of the size: near the wedge's edge the offset planes meet far out.
+        let wedge = Hull::from_points(&[
+            P3::new(0.0, 0.0, 0.0),
+            P3::new(1.0, 0.0, 0.0),
+            P3::new(0.0, 0.02, 0.0),
+            P3::new(0.0, 0.0, 1.0),
+            P3::new(1.0, 0.0, 1.0),
+            P3::new(0.0, 0.02, 1.0),
+        ])
+        .unwrap();
+        let ball = Hull::from_points(&shapes::uv_sphere(0.5, 8, 16).vertices).unwrap();
+        let mut rng = crate::rng::Rng::new(11);
+        let (mut inside, mut outside) = (0, 0);
+        for h in [&wedge, &ball] {
+            for _ in 0..4000 {
+                // In the hull's box grown by 30 % each way.
+                let (lo, hi) = (h.aabb.min, h.aabb.max);
+                let f = |a: f64, b: f64, u: f64| a + (b - a) * (1.6 * u - 0.3);
+                let p = P3::new(
+                    f(lo.x, hi.x, rng.next_f64()),
+                    f(lo.y, hi.y, rng.next_f64()),
+                    f(lo.z, hi.z, rng.next_f64()),
+                );
+                for eps in [0.0, 1e-3, 0.1] {
+                    let want = h.plane_distance(&p) <= eps;
+                    assert_eq!(h.within_planes(&p, eps), want, "{p:?} {eps}");
+                    if want {
+                        inside += 1;
+                    } else {
+                        outside += 1;
+                    }
+                }
+            }
+        }
+        assert!(inside > 500 && outside > 500, "{inside} {outside}");
     }
 
     #[test]

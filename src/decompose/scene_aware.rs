@@ -796,7 +796,7 @@ fn star(
             // sticks out.
             let out = probes
                 .iter()
-                .filter(|q| !hulls.iter().any(|h| h.plane_distance(q) <= p.tol))
+                .filter(|q| !hulls.iter().any(|h| h.within_planes(q, p.tol)))
                 .count();
             if out as f64 > 0.01 * probes.len() as f64 {
                 return None;

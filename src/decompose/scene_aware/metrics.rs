@@ -98,7 +98,7 @@ pub fn surface_distances(s: &Surface, hulls: &[Hull], n: usize) -> Vec<f64> {
                     !hulls
                         .iter()
                         .enumerate()
-                        .any(|(j, g)| j != i && g.plane_distance(p) <= eps)
+                        .any(|(j, g)| j != i && g.within_planes(p, eps))
                 })
                 .map(|p| s.distance(&p) / s.diag)
                 .collect::<Vec<_>>()
@@ -152,7 +152,7 @@ pub fn uncovered(s: &Surface, hulls: &[Hull], n: usize) -> f64 {
     let tol = 1e-3 * s.diag;
     let bad = pts
         .par_iter()
-        .filter(|p| !hulls.iter().any(|h| h.plane_distance(p) <= tol))
+        .filter(|p| !hulls.iter().any(|h| h.within_planes(p, tol)))
         .count();
     bad as f64 / pts.len() as f64
 }
