@@ -1129,14 +1129,15 @@ fn closest_splits(
             Some((k, (pa, pb)))
         })
         .collect();
-    built.sort_by(|(i, x), (j, y)| {
-        x.0.dev
-            .max(x.1.dev)
-            .total_cmp(&y.0.dev.max(y.1.dev))
-            .then(i.cmp(j))
-    });
+    built.sort_by(closer_split);
     built.truncate(keep);
     built
+}
+
+/// The order of [`closest_splits`]: by the worse half's deviation, then by the way's index.
+fn closer_split(x: &(usize, (Part, Part)), y: &(usize, (Part, Part))) -> std::cmp::Ordering {
+    let worse = |(_, (a, b)): &(usize, (Part, Part))| a.dev.max(b.dev);
+    worse(x).total_cmp(&worse(y)).then(x.0.cmp(&y.0))
 }
 
 /// The ways of splitting a part's patch in two, in a fixed order: 2-means in feature space,

@@ -1098,16 +1098,31 @@ fn star_pieces_in_batches_are_the_face_by_face_growth() {
     assert!(rejected > 0, "no bulge limit rejected a face");
 }
 
+/// The bowl as a surface, with the parameters and features of `strategy` and all its
+/// triangles, to make patches of.
+fn bowl_for_patches(
+    strategy: Strategy,
+) -> (
+    DecomposeOptions,
+    Surface,
+    Params,
+    patches::Features,
+    Vec<u32>,
+) {
+    let o = opts();
+    let s = Surface::new(&bowl()).unwrap();
+    let p = Params::new(&s, &o, strategy);
+    let f = patches::Features::new(&s, p.merge_depth, p.d_max);
+    let all: Vec<u32> = (0..s.mesh.triangles.len() as u32).collect();
+    (o, s, p, f, all)
+}
+
 /// The closest ways to split, built below the bound and the `keep`-th least deviation found
 /// so far, are those of building every way in full, admitting and sorting: on the bowl's
 /// patches, for both sets of ways, several shortlist lengths and bounds.
 #[test]
 fn closest_splits_are_those_of_building_every_way() {
-    let o = opts();
-    let s = Surface::new(&bowl()).unwrap();
-    let p = Params::new(&s, &o, Strategy::Planes);
-    let f = patches::Features::new(&s, p.merge_depth, p.d_max);
-    let all: Vec<u32> = (0..s.mesh.triangles.len() as u32).collect();
+    let (o, s, p, f, all) = bowl_for_patches(Strategy::Planes);
     let admit = |a: &Part, b: &Part| a.tris.len() + 8 >= b.tris.len();
     let mut compared = 0;
     for tris in patches::kmeans(&s, &f, &all, 6, p.lambda, 12) {
@@ -1133,12 +1148,7 @@ fn closest_splits_are_those_of_building_every_way() {
                         .iter()
                         .filter(|(_, (a, b))| a.dev < bound && b.dev < bound && admit(a, b))
                         .collect();
-                    want.sort_by(|(i, x), (j, y)| {
-                        x.0.dev
-                            .max(x.1.dev)
-                            .total_cmp(&y.0.dev.max(y.1.dev))
-                            .then(i.cmp(j))
-                    });
+                    want.sort_by(|x, y| closer_split(x, y));
                     want.truncate(keep);
                     let ways = split_ways(&s, &f, &p, &part, fine);
                     let got = closest_splits(&s, &p, &o, &part, ways, bound, keep, &admit);
@@ -1164,11 +1174,7 @@ fn closest_splits_are_those_of_building_every_way() {
 /// that definition, pair by pair, on the bowl's k-means patches.
 #[test]
 fn patches_sharing_a_vertex_are_adjacent() {
-    let o = opts();
-    let s = Surface::new(&bowl()).unwrap();
-    let p = Params::new(&s, &o, Strategy::Patches);
-    let f = patches::Features::new(&s, p.merge_depth, p.d_max);
-    let all: Vec<u32> = (0..s.mesh.triangles.len() as u32).collect();
+    let (o, s, p, f, all) = bowl_for_patches(Strategy::Patches);
     let parts: Vec<Part> = patches::kmeans(&s, &f, &all, 12, p.lambda, 12)
         .into_iter()
         .map(|tris| build_part(&s, &p, &o, tris, Vec::new()).unwrap())
