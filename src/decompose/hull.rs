@@ -67,7 +67,7 @@ impl Hull {
     /// sharp corner, and quicker.
     pub fn holds(&self, p: &P3, eps: f64) -> bool {
         (0..3).all(|a| p[a] >= self.aabb.min[a] - eps && p[a] <= self.aabb.max[a] + eps)
-            && self.planes.iter().all(|(n, d)| n.dot(&p.coords) - d <= eps)
+            && self.within_planes(p, eps)
     }
 
     /// Signed distance to the closest face plane: negative inside (a lower bound on the depth

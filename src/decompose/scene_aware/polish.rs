@@ -113,13 +113,7 @@ impl Samples {
     fn covering<'a>(&self, all: &[&'a Hull], skip: &[usize], eps: f64) -> Vec<&'a Hull> {
         all.iter()
             .enumerate()
-            .filter(|(i, g)| {
-                !skip.contains(i)
-                    && (0..3).all(|a| {
-                        g.aabb.min[a] - eps <= self.aabb.max[a]
-                            && self.aabb.min[a] <= g.aabb.max[a] + eps
-                    })
-            })
+            .filter(|(i, g)| !skip.contains(i) && g.aabb.intersects(&self.aabb, eps))
             .map(|(_, g)| *g)
             .collect()
     }
