@@ -104,19 +104,22 @@ impl Grid {
         (0..3).map(|a| hi[a] - lo[a] + 1).product()
     }
 
+    /// The indices of the cells the box of triangle `c` meets.
+    fn cells_of(&self, c: &[Vector; 3]) -> impl Iterator<Item = usize> + '_ {
+        let (lo, hi) = self.span(c);
+        let [_, ny, nz] = self.dims;
+        (lo[0]..=hi[0]).flat_map(move |i| {
+            (lo[1]..=hi[1]).flat_map(move |j| (lo[2]..=hi[2]).map(move |k| (i * ny + j) * nz + k))
+        })
+    }
+
     /// Every triangle in the cells its box meets, ascending in each cell.
     fn fill(self, corners: &[[Vector; 3]], entries: usize) -> Cells {
         let n = self.cells();
-        let index = |i: usize, j: usize, k: usize| (i * self.dims[1] + j) * self.dims[2] + k;
         let mut start = vec![0u32; n + 1];
         for c in corners {
-            let (lo, hi) = self.span(c);
-            for i in lo[0]..=hi[0] {
-                for j in lo[1]..=hi[1] {
-                    for k in lo[2]..=hi[2] {
-                        start[index(i, j, k) + 1] += 1;
-                    }
-                }
+            for id in self.cells_of(c) {
+                start[id + 1] += 1;
             }
         }
         for i in 0..n {
@@ -125,15 +128,9 @@ impl Grid {
         let mut next = start.clone();
         let mut tris = vec![0u32; entries];
         for (t, c) in corners.iter().enumerate() {
-            let (lo, hi) = self.span(c);
-            for i in lo[0]..=hi[0] {
-                for j in lo[1]..=hi[1] {
-                    for k in lo[2]..=hi[2] {
-                        let slot = &mut next[index(i, j, k)];
-                        tris[*slot as usize] = t as u32;
-                        *slot += 1;
-                    }
-                }
+            for id in self.cells_of(c) {
+                tris[next[id] as usize] = t as u32;
+                next[id] += 1;
             }
         }
         Cells {
