@@ -53,8 +53,9 @@
 //!    Once the budget is spent the patches are rebalanced and polished (`rebalance.rs`,
 //!    `polish.rs`: moves that bring the far tail of the surface distance closer, where the
 //!    loop above chases each hull's maximum), next to neighbours with the patches they may
-//!    touch pinned; then the free two-sided segments are rebuilt from all their patch's
-//!    vertices (`refit.rs`), which covers more of the surface. An object alone also runs a
+//!    touch pinned; then the free two-sided segments grow towards the patch vertices they
+//!    leave out, where the faces that adds hug the mesh (`refit.rs`), which covers more of the
+//!    surface. An object alone also runs a
 //!    second strategy, `Strategy::Planes` (top-down from 2 patches, with plane cuts across the
 //!    scene axes among the split candidates) and keeps whichever lies closer to the surface at
 //!    the 95th percentile.
@@ -96,7 +97,7 @@ use std::sync::Mutex;
 /// Engine name, recorded in reports and in the cache key.
 pub const NAME: &str = "scene_aware";
 /// Bumped whenever the output for the same input changes (invalidates the cache).
-pub const VERSION: u32 = 19;
+pub const VERSION: u32 = 20;
 
 /// What happened to one object.
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
@@ -117,8 +118,8 @@ pub struct ObjectReport {
     pub polish_rounds: usize,
     #[serde(default)]
     pub trimmed_patches: usize,
-    /// Wall segments rebuilt from all their patch's vertices once the patches were final
-    /// (see `refit.rs`).
+    /// Wall segments grown towards the patch vertices they left out once the patches were
+    /// final (see `refit.rs`).
     #[serde(default)]
     pub refitted: usize,
     /// The patches were found top-down, with plane cuts normal to the scene axes, which
