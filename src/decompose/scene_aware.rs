@@ -97,7 +97,7 @@ use std::sync::Mutex;
 /// Engine name, recorded in reports and in the cache key.
 pub const NAME: &str = "scene_aware";
 /// Bumped whenever the output for the same input changes (invalidates the cache).
-pub const VERSION: u32 = 20;
+pub const VERSION: u32 = 21;
 
 /// What happened to one object.
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
@@ -785,7 +785,11 @@ fn inflate(h: Hull, volume: f64, cap: f64, max_vertices: usize) -> Hull {
 
 /// Star pieces of a closed object seen from inside (see [`geom::star_pieces`]): the surface
 /// as rays from its centre of volume first meet it ([`geom::radial_mesh`], as many directions
-/// as `budget` pieces of `max_vertices` hold), cut into cones from the centre. The pieces fill
+/// as `budget` pieces of `max_vertices` hold), cut into cones from the centre. When that leaves
+/// the mesh out of reach (below), where the rays leave it for good instead: a generated
+/// avocado half is a closed flesh with its pit an open cap poking out of the cut face, which
+/// rays from the centre meet only after the face (alone: p95 2.16 % of its diagonal with
+/// surface patches, 0.38 % so). The pieces fill
 /// the object, so nothing of its inside is collision surface. A solid that is not convex
 /// (an apple's stem dimple, a bottle's shoulder) otherwise gets surface patches, a shell whose
 /// inner faces, the chords of round patches, lie inside it: the YCB apple's 32 patches kept
@@ -830,23 +834,24 @@ fn star(
     let best = geom::ray_frames(s)
         .par_iter()
         .filter_map(|axes| {
-            let (v, t) = geom::radial_mesh(s, &c, n, axes)?;
-            let pieces = (0..6)
-                .map(|k| p.tol * 1.5f64.powi(k))
-                .chain([f64::INFINITY])
-                .find_map(|bulge| {
-                    geom::star_pieces(&v, &t, &c, opts.max_vertices, budget, bulge)
-                })?;
-            let hulls: Vec<Hull> = pieces.iter().map(|x| x.0.clone()).collect();
-            // The mesh within reach: what the rays could not see (a fold, a second lobe)
-            // sticks out.
-            let out = probes
-                .iter()
-                .filter(|q| !hulls.iter().any(|h| h.within_planes(q, p.tol)))
-                .count();
-            if out as f64 > 0.01 * probes.len() as f64 {
-                return None;
-            }
+            let attempt = |last: bool| {
+                let (v, t) = geom::radial_mesh(s, &c, n, axes, last)?;
+                let pieces = (0..6)
+                    .map(|k| p.tol * 1.5f64.powi(k))
+                    .chain([f64::INFINITY])
+                    .find_map(|bulge| {
+                        geom::star_pieces(&v, &t, &c, opts.max_vertices, budget, bulge)
+                    })?;
+                let hulls: Vec<Hull> = pieces.iter().map(|x| x.0.clone()).collect();
+                // The mesh within reach: what the rays could not see (a fold, a second lobe)
+                // sticks out.
+                let out = probes
+                    .iter()
+                    .filter(|q| !hulls.iter().any(|h| h.within_planes(q, p.tol)))
+                    .count();
+                (out as f64 <= 0.01 * probes.len() as f64).then_some((pieces, hulls))
+            };
+            let (pieces, hulls) = attempt(false).or_else(|| attempt(true))?;
             let (p95, max) = distance_stats(s, &hulls)?;
             Some((p95, max, pieces))
         })

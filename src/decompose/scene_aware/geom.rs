@@ -851,7 +851,8 @@ pub fn principal_axes(
 
 /// The surface as seen from `c`, inside it: along each of `n` directions (spread over the
 /// ellipsoid of semi-axes `axes`, see [`ray_frames`]), the first point where a ray from `c`
-/// leaves the mesh, triangulated as the directions are. A polyhedron star-shaped about `c` by
+/// leaves the mesh (`last`: the last, where it leaves for good), triangulated as the
+/// directions are. A polyhedron star-shaped about `c` by
 /// construction, whose vertices lie on the mesh (or, through a hole, on its convex hull).
 /// `None` when more than 2 % of the rays find no surface (`c` outside or the mesh open wide).
 pub fn radial_mesh(
@@ -859,10 +860,21 @@ pub fn radial_mesh(
     c: &P3,
     n: usize,
     axes: &[V3; 3],
+    last: bool,
 ) -> Option<(Vec<P3>, Vec<[u32; 3]>)> {
     let (dirs, tris) = sphere_directions(n, axes)?;
     let far = 2.0 * s.diag;
-    let hits: Vec<Option<f64>> = dirs.par_iter().map(|u| s.ray(c, u, far)).collect();
+    let hits: Vec<Option<f64>> = dirs
+        .par_iter()
+        .map(|u| {
+            if last {
+                // Cast back from beyond the mesh: the first hit is the last crossing.
+                s.ray(&(c + u * far), &(-u), far).map(|t| far - t)
+            } else {
+                s.ray(c, u, far)
+            }
+        })
+        .collect();
     // A ray through a hole (scans have small ones) stops where it leaves the mesh's convex
     // hull instead; more than 2 % of them: the mesh is open wide.
     let misses = hits.iter().filter(|t| t.is_none()).count();
