@@ -97,7 +97,7 @@ use std::sync::Mutex;
 /// Engine name, recorded in reports and in the cache key.
 pub const NAME: &str = "scene_aware";
 /// Bumped whenever the output for the same input changes (invalidates the cache).
-pub const VERSION: u32 = 21;
+pub const VERSION: u32 = 22;
 
 /// What happened to one object.
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
@@ -154,6 +154,12 @@ pub struct ObjectReport {
     pub max_overlap: f64,
     /// Neighbours whose mesh interpenetrates this one: (object index, depth in m).
     pub mesh_penetration: Vec<(usize, f64)>,
+    /// The tolerance asked for (relative to the diagonal, see `DecomposeOptions::tolerance`)
+    /// and the hull budget (`max_hulls`): `distance_p95` above the tolerance is a warning.
+    #[serde(default)]
+    pub tolerance: f64,
+    #[serde(default)]
+    pub max_hulls: usize,
 }
 
 impl ObjectReport {
@@ -177,6 +183,15 @@ impl ObjectReport {
             w.push(format!(
                 "{} hull cut(s) against neighbours removed some surface coverage ({} hull(s) dropped)",
                 self.lossy_cuts, self.dropped_hulls
+            ));
+        }
+        if self.tolerance > 0.0 && self.distance_p95 > self.tolerance {
+            w.push(format!(
+                "collision hulls: 95th percentile of their distance to the mesh {:.2} % of its bounding-box diagonal, above the {:.2} % tolerance ({} of at most {} hulls; a larger --max-hulls usually brings them closer)",
+                self.distance_p95 * 100.0,
+                self.tolerance * 100.0,
+                self.hulls,
+                self.max_hulls
             ));
         }
         w
@@ -1757,6 +1772,8 @@ pub fn decompose_scene(
                 o.report.distance_max = max;
             }
         }
+        o.report.tolerance = opts.tolerance;
+        o.report.max_hulls = opts.max_hulls;
     }
     let polys: Vec<Vec<Option<parry3d_f64::shape::ConvexPolyhedron>>> = hulls
         .iter()

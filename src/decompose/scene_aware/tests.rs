@@ -182,6 +182,12 @@ fn check_scene(path: &Path) -> SceneAwareReport {
     for r in &rep.objects {
         assert_eq!(r.overlaps, 0);
         assert!(r.mesh_penetration.is_empty(), "{r:?}");
+        // An object farther from its mesh than the tolerance says so.
+        let above = r
+            .warnings()
+            .iter()
+            .any(|w| w.contains("above the 1.00 % tolerance"));
+        assert_eq!(above, r.distance_p95 > o.tolerance, "{r:?}");
     }
     // The support (object 0) keeps its cavity where it is a container.
     let s = geom::Surface::new(&meshes[0]).unwrap();
@@ -273,6 +279,29 @@ fn interpenetrating_meshes_are_reported_and_hulls_cut_apart() {
     assert!((pen.1 - 0.001).abs() < 1e-6, "{pen:?}");
     assert_eq!(deepest_cross_overlap(&hulls), 0.0);
     assert!(!rep.objects[0].warnings().is_empty());
+}
+
+/// The report warns when the hulls lie farther from the mesh than the tolerance (95th
+/// percentile), with the figures, and only then.
+#[test]
+fn hulls_above_the_tolerance_are_a_warning() {
+    let mut r = ObjectReport {
+        hulls: 32,
+        distance_p95: 0.0131,
+        tolerance: 0.01,
+        max_hulls: 32,
+        ..Default::default()
+    };
+    assert_eq!(
+        r.warnings(),
+        [
+            "collision hulls: 95th percentile of their distance to the mesh 1.31 % of its \
+          bounding-box diagonal, above the 1.00 % tolerance (32 of at most 32 hulls; a larger \
+          --max-hulls usually brings them closer)"
+        ]
+    );
+    r.distance_p95 = 0.0099;
+    assert!(r.warnings().is_empty());
 }
 
 #[test]
