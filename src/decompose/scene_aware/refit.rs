@@ -33,6 +33,8 @@
 //! beyond it. Faces within 3/4 of the tolerance instead: about the same p95 (GSO mug 1.154,
 //! sneaker 1.207, bowl fixture 1.314) for less coverage (sneaker 7.1 %).
 //!
+//! Star pieces grow the same way towards the mesh vertices outside them (see `star`).
+//!
 //! Patches within reach of a neighbour or the ground (the rebalancing's pins) are left as they
 //! are: what a neighbour rests on keeps the shape the contact splits are made for. One-sided
 //! patches too: their pushed copies already reach into the material, and rebuilding them
@@ -47,7 +49,7 @@ use rayon::prelude::*;
 
 /// Patch vertices farther outside the hull than this (relative to the diagonal) are the
 /// candidates to grow it towards.
-const OUTSIDE: f64 = 1e-4;
+pub(super) const OUTSIDE: f64 = 1e-4;
 
 /// Most candidates tried per hull.
 const TRIES: usize = 96;
@@ -94,7 +96,13 @@ pub(super) fn refit(
 /// `h` grown towards the points `pts` outside it, the farthest outside first (at most
 /// [`TRIES`], up to `max_vertices`): a point is added when the faces it brings stay within the
 /// tolerance of the mesh (see [`hugs`]). `None` when no point was added.
-fn grow(s: &Surface, p: &Params, opts: &DecomposeOptions, h: &Hull, pts: &[P3]) -> Option<Hull> {
+pub(super) fn grow(
+    s: &Surface,
+    p: &Params,
+    opts: &DecomposeOptions,
+    h: &Hull,
+    pts: &[P3],
+) -> Option<Hull> {
     let mut cur = h.clone();
     let mut grown = false;
     // Candidates still outside; the hull only grows, so a point inside stays inside.

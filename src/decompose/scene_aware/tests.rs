@@ -739,9 +739,10 @@ fn assert_star_filled(mesh: &Mesh, volume: f64, o: &DecomposeOptions) -> Vec<Hul
     let q = metrics::measure(mesh, &hulls);
     let filled = metrics::union_volume(&hulls, 96) / volume;
     eprintln!(
-        "{} pieces, p95 {:.3} %, union / solid volume {filled:.4}",
+        "{} pieces, p95 {:.3} %, union / solid volume {filled:.4}, uncovered {:.2} %",
         hulls.len(),
-        q.dist_p95 * 100.0
+        q.dist_p95 * 100.0,
+        q.uncovered * 100.0
     );
     assert!((0.97..=1.03).contains(&filled), "{filled}");
     assert!(q.dist_p95 <= o.tolerance, "{q:?}");
@@ -917,6 +918,9 @@ fn real_solids_are_filled_star_pieces_for_an_apple_and_a_pear_voxels_for_a_banan
     eprintln!("apple: {q:?}");
     assert!(q.dist_p95 <= 0.006, "{q:?}");
     assert!(q.volume_ratio >= 0.95, "{q:?}");
+    // The pieces grown towards the mesh vertices between the rays (measured 9.0 %; 14.1 %
+    // ungrown).
+    assert!(q.uncovered <= 0.11, "{q:?}");
     let pear = load("016_pear/textured.obj");
     let (hulls, rep) = decompose_scene(&[&pear], &o);
     assert!(rep.objects[0].star_pieces && !rep.objects[0].voxel_hulls);
@@ -925,6 +929,8 @@ fn real_solids_are_filled_star_pieces_for_an_apple_and_a_pear_voxels_for_a_banan
     eprintln!("pear: {q:?}");
     assert!(q.dist_p95 <= o.tolerance, "{q:?}");
     assert!(q.volume_ratio >= 0.95, "{q:?}");
+    // Measured 7.5 %; 14.3 % ungrown.
+    assert!(q.uncovered <= 0.10, "{q:?}");
     let banana = load("011_banana/textured.obj");
     let (hulls, rep) = decompose_scene(&[&banana], &o);
     assert!(!rep.objects[0].star_pieces);
