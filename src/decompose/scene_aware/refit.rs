@@ -111,14 +111,20 @@ pub(super) fn grow(
         if cur.vertices.len() >= opts.max_vertices {
             break;
         }
+        // Drop the candidates now inside and find the farthest outside, in one pass.
         let mut far: Option<(usize, f64)> = None;
-        outside.retain(|x| cur.plane_distance(x) > OUTSIDE * s.diag);
-        for (k, x) in outside.iter().enumerate() {
-            let d = cur.plane_distance(x);
-            if far.is_none_or(|(_, f)| d > f) {
-                far = Some((k, d));
+        let mut kept = 0;
+        for k in 0..outside.len() {
+            let d = cur.plane_distance(outside[k]);
+            if d > OUTSIDE * s.diag {
+                if far.is_none_or(|(_, f)| d > f) {
+                    far = Some((kept, d));
+                }
+                outside[kept] = outside[k];
+                kept += 1;
             }
         }
+        outside.truncate(kept);
         let Some((k, _)) = far else {
             break;
         };
