@@ -267,6 +267,54 @@ fn real_scenes_hulls_apart() {
     }
 }
 
+/// A sneaker resting on a tray needs none of the hulls kept back for its neighbour: what is
+/// left of its budget goes to its free patches, closer to its surface, and the hulls the tray
+/// may touch stay as they were.
+#[test]
+fn what_the_neighbours_leave_of_the_budget_is_spent() {
+    let Some(sh) = shared() else {
+        eprintln!("shared datasets not present: skipped");
+        return;
+    };
+    let o = opts();
+    let meshes = world_meshes(&sh.join("datasets/scenes/apparel/00004_shoe_tray"));
+    let refs: Vec<&Mesh> = meshes.iter().collect();
+    let (kept, r_kept) = decompose_scene_with(&refs, &o, false);
+    let (spent, r_spent) = decompose_scene(&refs, &o);
+    let reserve = o.max_hulls / 8;
+    assert_eq!(r_kept.objects[1].neighbour_splits, 0);
+    assert_eq!(kept[1].len(), o.max_hulls - reserve);
+    assert_eq!(spent[1].len(), o.max_hulls);
+    assert_eq!(r_spent.objects[1].topped_up, reserve);
+    assert_eq!(kept[0], spent[0], "the tray (exact boxes) is left as it is");
+    assert_eq!(deepest_cross_overlap(&spent), 0.0);
+    assert_limits(&spent[1], &o);
+    let p95 = |h: &[Hull]| metrics::measure(&meshes[1], h).dist_p95;
+    let (before, after) = (p95(&kept[1]), p95(&spent[1]));
+    eprintln!(
+        "sneaker p95 {:.3} % -> {:.3} %",
+        before * 100.0,
+        after * 100.0
+    );
+    assert!(after <= 0.95 * before, "{before} -> {after}");
+    // Every hull within reach of the tray (the bulge a hull may have, see
+    // `rebalance::reach`, with the tolerance of the sneaker's diagonal) is still there.
+    let diag = meshes[1].aabb().unwrap().diagonal();
+    let reach = o.clearance + 1.25 * o.tolerance * diag;
+    let trays: Vec<ConvexPolyhedron> = kept[0].iter().filter_map(geom::polyhedron).collect();
+    let touching: Vec<&Hull> = kept[1]
+        .iter()
+        .filter(|h| {
+            let x = geom::polyhedron(h).unwrap();
+            trays.iter().any(|t| geom::distance(&x, t) < reach)
+        })
+        .collect();
+    assert!(!touching.is_empty(), "the sole at least");
+    for h in touching {
+        assert!(spent[1].contains(h), "a hull the tray may touch changed");
+    }
+}
+
 #[test]
 fn interpenetrating_meshes_are_reported_and_hulls_cut_apart() {
     let a = shapes::cuboid(V3::new(0.05, 0.05, 0.05));
