@@ -267,9 +267,9 @@ fn real_scenes_hulls_apart() {
     }
 }
 
-/// A sneaker resting on a tray needs none of the hulls kept back for its neighbour: what is
-/// left of its budget goes to its free patches, closer to its surface, and the hulls the tray
-/// may touch stay as they were.
+/// A bowl holding a lemon needs one of the four hulls kept back for its neighbour: the rest
+/// goes to its free patches, closer to its surface, and the hulls the lemon may touch stay as
+/// they were.
 #[test]
 fn what_the_neighbours_leave_of_the_budget_is_spent() {
     let Some(sh) = shared() else {
@@ -277,41 +277,40 @@ fn what_the_neighbours_leave_of_the_budget_is_spent() {
         return;
     };
     let o = opts();
-    let meshes = world_meshes(&sh.join("datasets/scenes/apparel/00004_shoe_tray"));
+    let meshes = world_meshes(&sh.join("datasets/scenes/food/00001_lemon_bowl"));
     let refs: Vec<&Mesh> = meshes.iter().collect();
     let (kept, r_kept) = decompose_scene_with(&refs, &o, false);
     let (spent, r_spent) = decompose_scene(&refs, &o);
-    let reserve = o.max_hulls / 8;
-    assert_eq!(r_kept.objects[1].neighbour_splits, 0);
-    assert_eq!(kept[1].len(), o.max_hulls - reserve);
-    assert_eq!(spent[1].len(), o.max_hulls);
-    assert_eq!(r_spent.objects[1].topped_up, reserve);
-    assert_eq!(kept[0], spent[0], "the tray (exact boxes) is left as it is");
-    assert_eq!(deepest_cross_overlap(&spent), 0.0);
-    assert_limits(&spent[1], &o);
-    let p95 = |h: &[Hull]| metrics::measure(&meshes[1], h).dist_p95;
-    let (before, after) = (p95(&kept[1]), p95(&spent[1]));
-    eprintln!(
-        "sneaker p95 {:.3} % -> {:.3} %",
-        before * 100.0,
-        after * 100.0
+    let (r0, r1) = (&r_kept.objects[0], &r_spent.objects[0]);
+    let left = o.max_hulls - kept[0].len();
+    assert!(left > 0 && r0.neighbour_splits < o.max_hulls / 8, "{r0:?}");
+    assert_eq!(spent[0].len(), o.max_hulls);
+    assert_eq!(r1.topped_up, left);
+    assert_eq!(
+        kept[1], spent[1],
+        "the lemon (star pieces) is left as it is"
     );
+    assert_eq!(deepest_cross_overlap(&spent), 0.0);
+    assert_limits(&spent[0], &o);
+    let p95 = |h: &[Hull]| metrics::measure(&meshes[0], h).dist_p95;
+    let (before, after) = (p95(&kept[0]), p95(&spent[0]));
+    eprintln!("bowl p95 {:.3} % -> {:.3} %", before * 100.0, after * 100.0);
     assert!(after <= 0.95 * before, "{before} -> {after}");
-    // Every hull within reach of the tray (the bulge a hull may have, see
-    // `rebalance::reach`, with the tolerance of the sneaker's diagonal) is still there.
-    let diag = meshes[1].aabb().unwrap().diagonal();
+    // Every hull within reach of the lemon's (the bulge a hull may have, see
+    // `rebalance::reach`, with the tolerance of the bowl's diagonal) is still there.
+    let diag = meshes[0].aabb().unwrap().diagonal();
     let reach = o.clearance + 1.25 * o.tolerance * diag;
-    let trays: Vec<ConvexPolyhedron> = kept[0].iter().filter_map(geom::polyhedron).collect();
-    let touching: Vec<&Hull> = kept[1]
+    let others: Vec<ConvexPolyhedron> = kept[1].iter().filter_map(geom::polyhedron).collect();
+    let touching: Vec<&Hull> = kept[0]
         .iter()
         .filter(|h| {
             let x = geom::polyhedron(h).unwrap();
-            trays.iter().any(|t| geom::distance(&x, t) < reach)
+            others.iter().any(|t| geom::distance(&x, t) < reach)
         })
         .collect();
-    assert!(!touching.is_empty(), "the sole at least");
+    assert!(!touching.is_empty(), "the floor under the lemon at least");
     for h in touching {
-        assert!(spent[1].contains(h), "a hull the tray may touch changed");
+        assert!(spent[0].contains(h), "a hull the lemon may touch changed");
     }
 }
 
