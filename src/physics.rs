@@ -23,7 +23,7 @@ use rapier3d_f64::parry::bounding_volume::{Aabb, BoundingVolume};
 use rapier3d_f64::parry::query;
 use rapier3d_f64::parry::shape::Shape;
 use rapier3d_f64::prelude::{
-    ColliderBuilder, ColliderHandle, MassProperties, PhysicsWorld, RigidBodyBuilder,
+    ColliderBuilder, ColliderHandle, MassProperties, NarrowPhase, PhysicsWorld, RigidBodyBuilder,
     RigidBodyHandle,
 };
 use serde::Serialize;
@@ -529,14 +529,13 @@ pub fn rapier_mass_properties(body: &SimBody) -> Result<(f64, P3, Matrix3<f64>),
     ))
 }
 
-/// How far below z = 0 the floor's plane lies (m). Prepared scenes rest on z = 0, and a
+/// How far below z = 0 the floor's top face lies (m). Prepared scenes rest on z = 0, and a
 /// hull's lowest vertex ends up there only to f64 rounding: 1.4e-17 m *above* it, say. At such
-/// a separation, below GJK's tolerance, parry's contact query gave a hull touching the floor (a
-/// box then) at a sharp vertex (the apex of a basket floor's pie slice) a normal pointing up out
+/// a separation, below GJK's tolerance, parry's contact query gave a hull touching the floor
+/// at a sharp vertex (the apex of a basket floor's pie slice) a normal pointing up out
 /// of the floor, in about half the cases; Rapier then slid the fixture basket 2.4 mm and rolled
 /// its fruits out. Exactly at 0, below it, or 1e-12 m above it, the normals are right. 10 nm is
-/// far above the rounding and far below anything the checks measure; the half-space floor
-/// keeps it.
+/// far above the rounding and far below anything the checks measure.
 pub const FLOOR_GAP: f64 = 1e-8;
 
 /// Number of whole steps of length `dt` covering `time` (rounded to nearest).
@@ -656,6 +655,7 @@ impl<'a> Sim<'a> {
     fn new(bodies: &'a [SimBody], opts: &'a SettleOptions) -> Result<Self, PhysicsError> {
         validate_options(opts)?;
         let mut world = PhysicsWorld::new();
+        world.narrow_phase = NarrowPhase::with_query_dispatcher(fresh::FreshFloor);
         world.gravity = Vector::new(0.0, 0.0, -opts.gravity);
         let ip = &mut world.integration_parameters;
         ip.dt = opts.dt;
@@ -667,6 +667,7 @@ impl<'a> Sim<'a> {
         ip.static_contact_softness.natural_frequency = opts.static_contact_frequency;
 
         let mut names = std::collections::BTreeSet::new();
+        let mut scene_extent: f64 = 1.0;
         let mut handles = Vec::with_capacity(bodies.len());
         let mut colliders = Vec::with_capacity(bodies.len());
         let mut bbox_diagonal = Vec::with_capacity(bodies.len());
@@ -679,6 +680,8 @@ impl<'a> Sim<'a> {
                 ));
             }
             let (rb, diag) = body_builder(b, opts)?;
+            let t = b.pose.translation.vector;
+            scene_extent = scene_extent.max(t.abs().max() + diag);
             let h = world.insert_body(rb);
             let mut hs = Vec::with_capacity(b.hulls.len());
             for (k, hull) in b.hulls.iter().enumerate() {
@@ -719,18 +722,19 @@ impl<'a> Sim<'a> {
                     .fold(0.0, f64::max),
             );
         }
-        // The floor: a half-space whose plane lies `FLOOR_GAP` below z = 0. Not a box: parry's
-        // manifold between a convex hull and a box (`contact_manifold_pfm_pfm`) keeps last
-        // step's contact points while the normal turned less than 1° and the points slid less
-        // than 1 mm, so a hull rocking on a nearly flat bottom of many small faces sank through
-        // at the vertices it did not first touch (a cardboard package, one 64-vertex hull:
-        // 1–3.7 mm, failing the rest check). Against a half-space every vertex of the hull's
-        // support feature is a contact point at every step (it rests within 0.01 mm). The exact
-        // measurements use the vertex heights anyway (`floor_distance`).
-        let floor = world
-            .insert_body(RigidBodyBuilder::fixed().translation(Vector::new(0.0, 0.0, -FLOOR_GAP)));
+        // The floor: a large thin fixed box whose top face is `FLOOR_GAP` below z = 0, the only
+        // box of the world, whose contacts `fresh::FreshFloor` recomputes at every step. Not a
+        // half-space: parry's half-space manifold takes the hull face whose normal is closest
+        // to straight down, whether or not it holds the lowest vertex, and a YCB fork (10 thin
+        // hulls, 20 g) jittered up to 2.4 mm into it.
+        let half = 10.0 * scene_extent;
+        let floor = world.insert_body(RigidBodyBuilder::fixed().translation(Vector::new(
+            0.0,
+            0.0,
+            -0.5 * scene_extent - FLOOR_GAP,
+        )));
         world.insert_collider(
-            ColliderBuilder::halfspace(nalgebra::Unit::new_unchecked(Vector::Z))
+            ColliderBuilder::cuboid(half, half, 0.5 * scene_extent)
                 .friction(opts.floor_friction)
                 .restitution(opts.restitution),
             Some(floor),
@@ -1023,5 +1027,6 @@ fn body_builder(
     Ok((rb, diag))
 }
 
+mod fresh;
 #[cfg(test)]
 mod tests;
