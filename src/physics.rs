@@ -655,7 +655,7 @@ impl<'a> Sim<'a> {
     fn new(bodies: &'a [SimBody], opts: &'a SettleOptions) -> Result<Self, PhysicsError> {
         validate_options(opts)?;
         let mut world = PhysicsWorld::new();
-        world.narrow_phase = NarrowPhase::with_query_dispatcher(fresh::FreshFloor);
+        world.narrow_phase = NarrowPhase::with_query_dispatcher(fresh::Fresh);
         world.gravity = Vector::new(0.0, 0.0, -opts.gravity);
         let ip = &mut world.integration_parameters;
         ip.dt = opts.dt;
@@ -722,9 +722,8 @@ impl<'a> Sim<'a> {
                     .fold(0.0, f64::max),
             );
         }
-        // The floor: a large thin fixed box whose top face is `FLOOR_GAP` below z = 0, the only
-        // box of the world, whose contacts `fresh::FreshFloor` recomputes at every step. Not a
-        // half-space: parry's half-space manifold takes the hull face whose normal is closest
+        // The floor: a large thin fixed box whose top face is `FLOOR_GAP` below z = 0 (its
+        // contacts kept sound by `fresh::Fresh` like every pair's). Not a half-space: parry's half-space manifold takes the hull face whose normal is closest
         // to straight down, whether or not it holds the lowest vertex, and a YCB fork (10 thin
         // hulls, 20 g) jittered up to 2.4 mm into it.
         let half = 10.0 * scene_extent;

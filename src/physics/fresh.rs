@@ -1,4 +1,4 @@
-//! Floor contacts that do not miss the lowest point of a hull.
+//! Contact points that do not miss where two shapes interpenetrate most.
 //!
 //! parry's manifold between two convex polyhedra (`contact_manifold_pfm_pfm`, which Rapier uses
 //! for hull–hull and hull–box pairs) first tries to keep last step's contact points: while the
@@ -7,18 +7,12 @@
 //! a hull rocking on a nearly flat bottom of many small faces keeps contacts at the vertices it
 //! first touched while others sink through. The GSO cardboard package (one 64-vertex hull,
 //! 0.7 kg) sank 1–3.7 mm into the floor and failed the rest check at 7.5 mm, where MuJoCo
-//! holds it within 1.2 mm; the LEGO suitcase (3.7 mm) and the porcelain pitcher (1.0 mm)
-//! likewise. [`FreshFloor`] checks every manifold with the floor before handing the pair to
-//! parry's default dispatcher: when the hull's lowest point lies deeper under the floor's face
-//! than every kept point (see [`stale`]), the manifold is marked deformed and parry computes
-//! it from the current poses (its points then include the deepest one). The package rests
-//! within 0.01 mm.
-//!
-//! Hull–hull pairs keep parry's reuse: there is no face to measure "lowest" against. They can
-//! sink the same way (the package on a fixed box hull: 1–4 mm); recomputing all their
-//! manifolds at every step fixed that, but moved the pen of the `pen_mug` fixture to a rest
-//! pose from which MuJoCo rolls it 12° about its axis (1.2 mm), beyond the agreement test's
-//! 1 mm and 1°.
+//! holds it within 1.2 mm (the LEGO suitcase 3.7 mm, the porcelain pitcher 1.0 mm likewise),
+//! and 1–4 mm into a fixed box hull under it. [`Fresh`] checks every manifold before handing
+//! the pair to parry's default dispatcher: when the kept points miss the deepest
+//! interpenetration (see [`stale`]), the manifold is marked deformed and parry computes it
+//! from the current poses, the deepest point among its points. The package rests within
+//! 0.01 mm of the floor and of the box; the settle benchmark runs as fast as before.
 
 use rapier3d_f64::geometry::{ContactData, ContactManifoldData};
 use rapier3d_f64::math::{Pose, Real, Vector};
@@ -26,62 +20,44 @@ use rapier3d_f64::parry::query::details::{NormalConstraints, ShapeCastOptions};
 use rapier3d_f64::parry::query::{
     ClosestPoints, Contact, ContactManifold, ContactManifoldsWorkspace, DefaultQueryDispatcher,
     NonlinearRigidMotion, PersistentQueryDispatcher, QueryDispatcher, ShapeCastHit, ShapeDistance,
-    ShapeIntersection, TrackedContact, Unsupported,
+    ShapeIntersection, Unsupported,
 };
 use rapier3d_f64::parry::shape::Shape;
 
-/// parry's default dispatcher, but the floor's contact points kept from the last step are
-/// recomputed when they miss the hull's lowest point (see [`stale`]).
-pub(super) struct FreshFloor;
+/// parry's default dispatcher, but contact points kept from the last step are recomputed
+/// when they miss the deepest interpenetration (see [`stale`]).
+pub(super) struct Fresh;
 
 type Manifold = ContactManifold<ContactManifoldData, ContactData>;
 
-/// Below the deepest contact kept from the last step, how much deeper a hull's lowest point
-/// under the floor's face may lie before the floor's contacts are recomputed (m).
+/// How much deeper than every contact point kept from the last step two shapes may
+/// interpenetrate before their manifold is recomputed (m).
 const MISSED: Real = 1e-5;
 
-/// Whether `m`, a manifold between the floor (the only box of the world: hulls are convex
-/// polyhedra) and a hull, kept contact points that miss the hull's lowest point: that point
-/// lies more than [`MISSED`] deeper under the floor's face than every kept point. Recomputing
-/// the floor's contacts at every step instead let resting bodies jitter (a ball in a dynamic
-/// bowl of box hulls turned 1.5° during the rest check).
+/// Whether `m` kept contact points that miss where the shapes interpenetrate most: their
+/// exact penetration depth (parry's GJK/EPA contact query) is more than [`MISSED`] deeper
+/// than every kept point. Recomputing every manifold at every step instead moved bodies at
+/// rest (a ball in a dynamic bowl of box hulls turned 1.5° during the rest check with the
+/// floor's manifolds recomputed; the pen of `pen_mug` came to a rest pose from which MuJoCo
+/// rolls it 12° with all of them).
 fn stale(pos12: &Pose, g1: &dyn Shape, g2: &dyn Shape, m: &Manifold) -> bool {
     if m.points.is_empty() {
         return false;
     }
-    // The floor's frame f, its face normal there, the hull h and the pose of h in f.
-    let (hull, n, pos_fh, floor_first) = if g1.as_cuboid().is_some() {
-        (g2, m.local_n1, *pos12, true)
-    } else if g2.as_cuboid().is_some() {
-        (g1, m.local_n2, pos12.inverse(), false)
-    } else {
-        return false;
-    };
-    let Some(support) = hull.as_support_map() else {
-        return false;
-    };
-    // Each kept point: (point on the floor, point on the hull), both in f.
-    let pair = |pt: &TrackedContact<ContactData>| {
-        if floor_first {
-            (pt.local_p1, pos_fh * pt.local_p2)
-        } else {
-            (pt.local_p2, pos_fh * pt.local_p1)
-        }
-    };
+    // Last step's points at the current poses, as parry's reuse would measure them.
     let kept = m
         .points
         .iter()
-        .map(|pt| {
-            let (on_floor, on_hull) = pair(pt);
-            (on_hull - on_floor).dot(n)
-        })
+        .map(|pt| (*pos12 * pt.local_p2 - pt.local_p1).dot(m.local_n1))
         .fold(Real::INFINITY, Real::min);
-    let face = pair(&m.points[0]).0;
-    let lowest = pos_fh * support.local_support_point(pos_fh.rotation.inverse() * -n);
-    (lowest - face).dot(n) < kept - MISSED
+    DefaultQueryDispatcher
+        .contact(pos12, g1, g2, 0.0)
+        .ok()
+        .flatten()
+        .is_some_and(|c| c.dist < 0.0 && c.dist < kept - MISSED)
 }
 
-impl QueryDispatcher for FreshFloor {
+impl QueryDispatcher for Fresh {
     fn intersection_test(
         &self,
         pos12: &Pose,
@@ -153,7 +129,7 @@ impl QueryDispatcher for FreshFloor {
     }
 }
 
-impl PersistentQueryDispatcher<ContactManifoldData, ContactData> for FreshFloor {
+impl PersistentQueryDispatcher<ContactManifoldData, ContactData> for Fresh {
     fn contact_manifolds(
         &self,
         pos12: &Pose,

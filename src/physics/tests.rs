@@ -363,14 +363,14 @@ fn a_plate_of_pie_slices_resting_on_the_floor_stays_put() {
     assert!(b.settle_rotation_deg < 0.01, "{}", b.settle_rotation_deg);
 }
 
-/// Scanned objects alone rest on the floor instead of sinking into it: a flat package (GSO,
+/// Scanned objects rest on the floor, and on a box, instead of sinking into it: a flat package (GSO,
 /// one 64-vertex hull whose bottom is many nearly coplanar small faces) and a fork (YCB, 10
 /// thin hulls, 20 g). With parry's reuse of last step's contact points against the box floor,
 /// the package sank 1–3.7 mm (rest check failed at 7.5 mm; MuJoCo holds it within 1.2 mm and
 /// 0.6°); on a half-space floor, whose manifold takes the hull face closest to facing straight
 /// down rather than the lowest point, the fork jittered up to 2.4 mm into it.
 #[test]
-fn scanned_objects_alone_rest_on_the_floor_without_sinking() {
+fn scanned_objects_rest_on_the_floor_and_on_a_box_without_sinking() {
     let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
     let Some(objects) = [root.join("../shared"), root.join("../../shared")]
         .into_iter()
@@ -410,5 +410,20 @@ fn scanned_objects_alone_rest_on_the_floor_without_sinking() {
             lowest * 1e3
         );
         assert!(lowest > -5e-5, "{file}: {lowest}");
+        // The same on a fixed box hull 2 cm thick: hull–hull contacts (1–4 mm deep before).
+        let mut on_tray = bodies.clone();
+        on_tray[0].pose = at(0.0, 0.0, 0.02) * on_tray[0].pose;
+        let mut tray = box_body("tray", V3::new(0.5, 0.5, 0.02), 1.0, at(0.0, 0.0, 0.01));
+        tray.fixed = true;
+        on_tray.push(tray);
+        let r = settle(&on_tray, &SettleOptions::default()).unwrap();
+        let b = &r.bodies[0];
+        assert!(r.passed, "{file} on the tray: {:?}", b.reasons);
+        assert_eq!(b.rest_max_penetration_with.as_deref(), Some("tray"));
+        assert!(
+            b.rest_max_penetration < 5e-5,
+            "{file}: {}",
+            b.rest_max_penetration
+        );
     }
 }
