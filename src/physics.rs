@@ -723,9 +723,10 @@ impl<'a> Sim<'a> {
             );
         }
         // The floor: a large thin fixed box whose top face is `FLOOR_GAP` below z = 0 (its
-        // contacts kept sound by `fresh::Fresh` like every pair's). Not a half-space: parry's half-space manifold takes the hull face whose normal is closest
-        // to straight down, whether or not it holds the lowest vertex, and a YCB fork (10 thin
-        // hulls, 20 g) jittered up to 2.4 mm into it.
+        // contacts kept sound by `fresh::Fresh` like every pair's). Not a half-space: parry's
+        // half-space manifold takes the hull face whose normal is closest to straight down,
+        // whether or not it holds the lowest vertex, and a YCB fork (10 thin hulls, 20 g)
+        // jittered up to 2.4 mm into it.
         let half = 10.0 * scene_extent;
         let floor = world.insert_body(RigidBodyBuilder::fixed().translation(Vector::new(
             0.0,

@@ -1038,15 +1038,10 @@ fn voxel_parts(s: &Surface, opts: &DecomposeOptions, budget: usize) -> Option<(f
 /// the plate but within the loose bound of its big triangles (circumradius 12 mm) and the
 /// plate's tolerance (3.7 mm), kept its star pieces out (p95 3.37 % of its diagonal with
 /// patches, 0.36 % with the star pieces).
-fn keeps_support(
-    s: &Surface,
-    p: &Params,
-    opts: &DecomposeOptions,
-    under: &[f64],
-    parts: &[Part],
-) -> bool {
+///
+/// `support`: those triangles (see [`support`]).
+fn keeps_support(s: &Surface, p: &Params, support: &[u32], parts: &[Part]) -> bool {
     let eps = 1e-9 * s.diag;
-    let support = support(s, p, opts, under);
     parts.iter().all(|q| {
         let held: Vec<u32> = support
             .iter()
@@ -1409,9 +1404,10 @@ fn decompose_object(
     // bottle it took 0.26 s of the 0.33 s, for p95 0.65 % where the star pieces read 0.77 %
     // (CoACD 32×64: 4.52 %).
     let mut whole: Vec<(f64, Vec<Part>, Solid)> = Vec::new();
-    // A candidate, when it keeps what a neighbour may rest on.
+    // What a neighbour may rest on; a candidate, when it keeps that.
+    let carried = support(s, &p, opts, under);
     let candidate = |c: Option<(f64, Vec<Part>)>, kind: Solid| {
-        c.filter(|(_, q)| keeps_support(s, &p, opts, under, q))
+        c.filter(|(_, q)| keeps_support(s, &p, &carried, q))
             .map(|(d, q)| (d, q, kind))
     };
     // The closest whose hulls reach at most `bound` past the surface anywhere: V-HACD's hulls
@@ -1446,7 +1442,7 @@ fn decompose_object(
         (parts, report, p)
     };
     // One strategy for a set of closed convex pieces, and under a neighbour (see `Strategy`).
-    let strategies = if rest.is_empty() || !support(s, &p, opts, under).is_empty() {
+    let strategies = if rest.is_empty() || !carried.is_empty() {
         &strategies[..strategies.len().min(1)]
     } else {
         strategies
@@ -1917,8 +1913,8 @@ fn decompose_scene_with(
 /// Step 3b: spend what the neighbours left of each object's budget. An object next to a
 /// neighbour keeps `max_hulls/8` of it for the contact splits and the refinement (step 3),
 /// which often need few or none: the bowl holding the lemon of `00001` ended with 29 of its 32
-/// hulls and p95 1.75 % of the diagonal (1.64 % with the three left spent). When the object's hulls lie farther from the surface than the
-/// tolerance (p95), its free patches (not pinned, see `rebalance::pinned`, and not cut
+/// hulls and p95 1.75 % of the diagonal (1.64 % with the three left spent). When the object's
+/// hulls lie farther from the surface than the tolerance (p95), its free patches (not pinned, see `rebalance::pinned`, and not cut
 /// against a neighbour) go through the quality loop again up to `max_hulls`, then the
 /// polishing and the refit; the patches a neighbour may touch are left as they were. Returns
 /// whether any object changed (the refinement then runs again for the new hulls).
