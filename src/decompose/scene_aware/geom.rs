@@ -533,6 +533,7 @@ pub fn cone_pieces(
         max_vertices,
         max_pieces,
         f64::INFINITY,
+        None,
     )
 }
 
@@ -542,7 +543,9 @@ pub fn cone_pieces(
 /// polyhedron, with no gap between pieces. On a convex polyhedron the pieces lie inside it;
 /// on a non-convex one a piece bulges past it where its patch is concave as seen from `c`: a
 /// face joins a patch only if no vertex of the patch then lies deeper than `bulge` under the
-/// piece's outer boundary, along its ray from `c` (so concave regions get smaller pieces).
+/// piece's outer boundary, along its ray from `c` (so concave regions get smaller pieces), and
+/// the piece passes `accept` (if given; it must hold for a piece whenever it holds for a larger
+/// one, as the bulge does, see [`Growth::grow_checked`]).
 pub fn star_pieces(
     vertices: &[P3],
     triangles: &[[u32; 3]],
@@ -550,6 +553,7 @@ pub fn star_pieces(
     max_vertices: usize,
     max_pieces: usize,
     bulge: f64,
+    accept: Option<&(dyn Fn(&Hull) -> bool + Sync)>,
 ) -> Option<Vec<(Hull, Vec<P3>, V3)>> {
     let cap = max_vertices.checked_sub(1).filter(|&c| c >= 3)?;
     let nt = triangles.len();
@@ -591,14 +595,15 @@ pub fn star_pieces(
             queued_mark: &mut queued,
         };
         g.queued_mark[seed] = true;
-        if bulge.is_finite() {
+        if bulge.is_finite() || accept.is_some() {
             g.grow_checked(triangles, &adj, cap, |verts| {
                 let mut pts: Vec<P3> = verts.iter().map(|&i| vertices[i as usize]).collect();
                 pts.push(*c);
                 let h = Hull::from_points(&pts)?;
                 let ok = pts[..pts.len() - 1]
                     .iter()
-                    .all(|v| depth_under(&h, c, v) <= bulge);
+                    .all(|v| depth_under(&h, c, v) <= bulge)
+                    && accept.is_none_or(|a| a(&h));
                 Some((ok, h.volume, h.aabb.diagonal()))
             });
         } else {
