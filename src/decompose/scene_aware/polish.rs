@@ -35,8 +35,7 @@
 //! the mug fixture (0.82, 0.46 since wall segments' seams are left out of their deviation) is
 //! within the tolerance and left as it is.
 //!
-//! Next to a neighbour, the patches within reach of it or, facing down, of the ground are
-//! pinned as in the rebalancing (see `rebalance::pinned`): never trimmed, merged, moved or
+//! Next to a neighbour, the patches within reach of it are pinned as in the rebalancing (see `rebalance::pinned`): never trimmed, merged, moved or
 //! split, and no move makes a new one, since they are the contact geometry the agreement tests
 //! hold. On the ten shared scenes (20,000 samples per object, before the solids got star
 //! pieces and V-HACD's hulls) this lowered p95 on 11 of 25 objects (the spoon of
@@ -189,9 +188,8 @@ impl Samples {
 type Sampled = (Part, Arc<Samples>);
 
 /// Polish `parts` in place (at most `rounds` kept moves) when their p95 distance exceeds the
-/// tolerance; returns the patches trimmed and the moves kept. Patches within reach of the
-/// ground or a neighbour (`near`, see `rebalance::pinned`) are left as they are, and no move
-/// makes one.
+/// tolerance; returns the patches trimmed and the moves kept. Patches within reach of a
+/// neighbour (`near`, see `rebalance::pinned`) are left as they are, and no move makes one.
 pub(super) fn polish(
     s: &Surface,
     f: &Features,

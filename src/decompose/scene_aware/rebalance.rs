@@ -22,11 +22,11 @@
 //! segment under it is fine, since the merged hull's top is the rim. Scenes are Z-up by the
 //! time they are decomposed.
 //!
-//! Next to neighbours, the patches within reach of a neighbour or, facing down, of the ground
-//! are pinned (see [`pinned`]): on the `ball_bowl` scene, a bowl rebalanced everywhere let
-//! MuJoCo roll the ball 0.6 mm and turn it 1.02° while Rapier held it (merges only; with the
-//! border moves Rapier rolled it 7 mm). Pinning only the patches near the ball changed
-//! nothing; pinning the bowl's foot too gave back the motion of no rebalancing (0.32 mm).
+//! Next to neighbours, the patches within reach of a neighbour are pinned (see [`pinned`]):
+//! on the `ball_bowl` scene, a bowl rebalanced everywhere let MuJoCo roll the ball 0.6 mm and
+//! turn it 1.02° while Rapier held it (merges only; with the border moves Rapier rolled it
+//! 7 mm). The bowl's foot, near the ground, was pinned too until Rapier's stale contacts were
+//! recomputed; it no longer changes the ball's motion (see `decompose_scene_with`).
 //!
 //! Merged hulls are cached by the pair of patch ids (a patch gets a new id when it changes),
 //! so a round builds only the merges next to the three patches it changed.
@@ -175,8 +175,8 @@ pub(super) fn rebalance(
     kept
 }
 
-/// Whether a patch (`tris`, its hull deviating `dev`) is within reach of the ground or a
-/// neighbour (`near`: per triangle, see `contact_distances`): its hull may bulge `dev` past
+/// Whether a patch (`tris`, its hull deviating `dev`) is within reach of a neighbour
+/// (`near`: per triangle, see `contact_distances`): its hull may bulge `dev` past
 /// its surface, a quarter more for sampling. Pinned patches are not merged, moved or split
 /// by the rebalancing.
 pub(super) fn pinned(
@@ -192,7 +192,7 @@ pub(super) fn pinned(
     }
 }
 
-/// How near the ground or a neighbour (`near`) a triangle of a patch whose hull deviates
+/// How near a neighbour (`near`) a triangle of a patch whose hull deviates
 /// `dev` may touch it: the hull may bulge `dev` (at least the tolerance) past the surface, a
 /// quarter more for sampling.
 pub(super) fn reach(dev: f64, p: &Params, opts: &DecomposeOptions) -> f64 {
