@@ -57,7 +57,7 @@
 //!    loop above chases each hull's maximum), next to neighbours with the patches they may
 //!    touch pinned; then the free two-sided segments grow towards the patch vertices they
 //!    leave out, where the faces that adds hug the mesh (`refit.rs`), which covers more of the
-//!    surface. An object alone, or one that nothing rests on, also runs a
+//!    surface. An object alone, or one that no neighbour both rests and leans on, also runs a
 //!    second strategy, `Strategy::Planes` (top-down from 2 patches, with plane cuts across the
 //!    scene axes among the split candidates) and keeps whichever lies closer to the surface at
 //!    the 95th percentile.
@@ -101,7 +101,7 @@ use std::sync::Mutex;
 /// Engine name, recorded in reports and in the cache key.
 pub const NAME: &str = "scene_aware";
 /// Bumped whenever the output for the same input changes (invalidates the cache).
-pub const VERSION: u32 = 27;
+pub const VERSION: u32 = 28;
 
 /// What happened to one object.
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
@@ -426,14 +426,19 @@ impl Memo {
 ///   1.02 → 0.82 % (alone). The object's own principal axes did worse (mug fixture 0.90 %,
 ///   sneaker 2.41 against 2.10 %): their horizontal pair is arbitrary on a round object.
 ///
-/// Under a neighbour (an up-facing triangle within reach of a neighbour that may rest on it,
-/// see `support`) only `Patches` runs. Its contact geometry is what the MuJoCo agreement
-/// tests hold; the plane cuts put seams where a neighbour rests. On `ball_bowl` the halving
-/// planes split the floor in four through the ball's resting point, a pit of four tilted
-/// chords, and MuJoCo rolled the ball 2.6 mm in 2 s (limit 1 mm). Cuts at thirds or
-/// quarters instead failed Rapier's own validation of `ball_bowl` or `pen_mug`. An object
-/// that only rests on others runs both, as alone: the sneaker on the tray of `00004`, p95
-/// 1.74 → 1.68 % of its diagonal; settled in MuJoCo it moved 0.25 mm (0.29 mm before).
+/// Under a neighbour that also leans on its side (an up-facing triangle within reach of a
+/// neighbour that may rest on it, see `support`, and a steeper one within the clearance of a
+/// neighbour, see [`leaned_on`]) only `Patches` runs: its contact geometry is what the MuJoCo
+/// agreement tests hold, and the horizontal cuts put a seam under the pen of `pen_mug`
+/// leaning on its mug's rim (with both, Rapier's validation failed and MuJoCo turned the pen
+/// 7.8° in 2 s). An object that carries neighbours only on level triangles, or only rests on
+/// others, runs both, as alone: the dice cup of `00010` p95 2.70 → 2.34 %, the avocado's
+/// plate of `00006` 1.25 → 1.09 %, the bowl of `ball_bowl` 1.64 → 1.62 %, the sneaker on the
+/// tray of `00004` 1.74 → 1.68 %. All of them still settle, and MuJoCo moves the ball of
+/// `ball_bowl` 0.42 mm and turns it 0.70° in 2 s from its settled pose (0.39 mm and 0.66°
+/// with the patches). Before Rapier's stale contact manifolds were recomputed
+/// (`physics::fresh`), the halving planes under that ball made MuJoCo roll it 2.6 mm, and
+/// every carried object took the patches.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 enum Strategy {
     Patches,
@@ -1185,6 +1190,15 @@ fn flat_over(s: &Surface, p: &Params, support: &[u32], h: &Hull) -> bool {
     rebalance::lift(s, h, &held) <= CONTACT_DEV * p.tol
 }
 
+/// Whether a neighbour may touch a steep triangle (normal more than about 25° from vertical):
+/// one leans on the object's side, as the pen of `pen_mug` on its mug's rim. `near`: as
+/// [`free_passing_walls`] leaves it, within the clearance there.
+fn leaned_on(s: &Surface, near: &[f64], opts: &DecomposeOptions) -> bool {
+    near.iter()
+        .zip(&s.tri_normal)
+        .any(|(&d, n)| d <= opts.clearance && n.z.abs() < SUPPORT_NZ)
+}
+
 /// The up-facing triangles within reach of a neighbour that may rest on them (`under`, see
 /// `contact_distances`; none when it is empty).
 fn support(s: &Surface, p: &Params, opts: &DecomposeOptions, under: &[f64]) -> Vec<u32> {
@@ -1583,8 +1597,9 @@ fn decompose_object(
         let (parts, report) = grow_parts(s, &feat, &p, opts, &fixed, &rest, budget, effort, near);
         (parts, report, p)
     };
-    // One strategy for a set of closed convex pieces, and under a neighbour (see `Strategy`).
-    let strategies = if rest.is_empty() || !carried.is_empty() {
+    // One strategy for a set of closed convex pieces, and under a neighbour leaning on its side
+    // (see `Strategy`).
+    let strategies = if rest.is_empty() || (!carried.is_empty() && leaned_on(s, near, opts)) {
         &strategies[..strategies.len().min(1)]
     } else {
         strategies
