@@ -35,6 +35,19 @@ fn world_meshes(path: &Path) -> Vec<Mesh> {
 }
 
 /// Independent check of the limits every hull must meet.
+/// A shared scene's world meshes and their decomposition at [`opts`]; `None` (the test is
+/// skipped) without `shared/`.
+fn shared_scene(name: &str) -> Option<(Vec<Mesh>, Vec<Vec<Hull>>, SceneAwareReport)> {
+    let Some(sh) = shared() else {
+        eprintln!("shared datasets not present: skipped");
+        return None;
+    };
+    let meshes = world_meshes(&sh.join("datasets/scenes").join(name));
+    let refs: Vec<&Mesh> = meshes.iter().collect();
+    let (hulls, rep) = decompose_scene(&refs, &opts());
+    Some((meshes, hulls, rep))
+}
+
 fn assert_limits(hulls: &[Hull], o: &DecomposeOptions) {
     assert!(
         !hulls.is_empty() && hulls.len() <= o.max_hulls,
@@ -320,14 +333,10 @@ fn what_the_neighbours_leave_of_the_budget_is_spent() {
 /// Star pieces under slabs where the bottle stands bring it within the tolerance (0.81 %).
 #[test]
 fn a_solid_carrying_a_neighbour_on_an_uneven_top_is_star_pieces_under_slabs() {
-    let Some(sh) = shared() else {
-        eprintln!("shared datasets not present: skipped");
+    let Some((meshes, hulls, rep)) = shared_scene("household/00009_bottle_lunchbox") else {
         return;
     };
     let o = opts();
-    let meshes = world_meshes(&sh.join("datasets/scenes/household/00009_bottle_lunchbox"));
-    let refs: Vec<&Mesh> = meshes.iter().collect();
-    let (hulls, rep) = decompose_scene(&refs, &o);
     let r = &rep.objects[0];
     assert!(r.star_pieces && r.slabs >= 4, "{r:?}");
     assert_limits(&hulls[0], &o);
@@ -345,15 +354,10 @@ fn a_solid_carrying_a_neighbour_on_an_uneven_top_is_star_pieces_under_slabs() {
 /// (measured 1.25 against 0.99 % of its diagonal; 1.51 % when its underside was pinned).
 #[test]
 fn the_ground_does_not_pin_what_stands_on_it() {
-    let Some(sh) = shared() else {
-        eprintln!("shared datasets not present: skipped");
+    let Some((meshes, in_scene, rep)) = shared_scene("food/00006_avocado_plate") else {
         return;
     };
-    let o = opts();
-    let meshes = world_meshes(&sh.join("datasets/scenes/food/00006_avocado_plate"));
-    let refs: Vec<&Mesh> = meshes.iter().collect();
-    let (in_scene, rep) = decompose_scene(&refs, &o);
-    let (alone, _) = decompose_scene(&refs[..1], &o);
+    let (alone, _) = decompose_scene(&[&meshes[0]], &opts());
     let p95 = |h: &[Hull]| metrics::measure(&meshes[0], h).dist_p95;
     let (a, b) = (p95(&alone[0]), p95(&in_scene[0]));
     eprintln!(
@@ -377,13 +381,9 @@ fn only_a_neighbour_leaning_on_a_side_keeps_a_carrier_to_the_patches() {
     let refs: Vec<&Mesh> = meshes.iter().collect();
     let (_, rep) = decompose_scene(&refs, &o);
     assert!(!rep.objects[0].top_down, "{:?}", rep.objects[0]);
-    let Some(sh) = shared() else {
-        eprintln!("shared datasets not present: skipped");
+    let Some((meshes, hulls, rep)) = shared_scene("toys/00010_dice_cup") else {
         return;
     };
-    let meshes = world_meshes(&sh.join("datasets/scenes/toys/00010_dice_cup"));
-    let refs: Vec<&Mesh> = meshes.iter().collect();
-    let (hulls, rep) = decompose_scene(&refs, &o);
     assert!(rep.objects[0].top_down, "{:?}", rep.objects[0]);
     let p95 = metrics::measure(&meshes[0], &hulls[0]).dist_p95;
     eprintln!("dice cup p95 {:.3} %", p95 * 100.0);
@@ -965,14 +965,10 @@ fn star_pieces_reach_a_cap_poking_out_of_a_solid() {
 /// tolerance of it.
 #[test]
 fn an_avocado_half_on_a_plate_is_filled_by_star_pieces() {
-    let Some(sh) = shared() else {
-        eprintln!("shared datasets not present: skipped");
+    let Some((meshes, hulls, rep)) = shared_scene("food/00006_avocado_plate") else {
         return;
     };
     let o = opts();
-    let meshes = world_meshes(&sh.join("datasets/scenes/food/00006_avocado_plate"));
-    let refs: Vec<&Mesh> = meshes.iter().collect();
-    let (hulls, rep) = decompose_scene(&refs, &o);
     let avocado = &rep.objects[1];
     eprintln!("avocado: {avocado:?}");
     assert!(avocado.star_pieces, "{avocado:?}");
