@@ -1023,8 +1023,8 @@ fn star_on_slabs(
     opts: &DecomposeOptions,
     budget: usize,
     support: &[u32],
+    feat: &patches::Features,
 ) -> Option<(f64, Vec<Part>)> {
-    let feat = patches::Features::new(s, p.merge_depth, p.d_max);
     let level = Params {
         tol: CONTACT_DEV * p.tol,
         memo: Memo::default(),
@@ -1041,7 +1041,7 @@ fn star_on_slabs(
         .par_iter()
         .filter_map(|&k| {
             let n = (k * budget / 28).max(1);
-            let mut slabs: Vec<Part> = patches::kmeans(s, &feat, support, n / 2, p.lambda, 16)
+            let mut slabs: Vec<Part> = patches::kmeans(s, feat, support, n / 2, p.lambda, 16)
                 .into_iter()
                 .filter_map(|g| build_part(s, &level, opts, g, Vec::new()))
                 .collect();
@@ -1053,7 +1053,7 @@ fn star_on_slabs(
                 else {
                     break;
                 };
-                match split(s, &feat, &level, opts, &slabs[w], f64::INFINITY) {
+                match split(s, feat, &level, opts, &slabs[w], f64::INFINITY) {
                     Some((a, b)) => {
                         slabs[w] = a;
                         slabs.push(b);
@@ -1086,15 +1086,19 @@ enum Solid {
 }
 
 impl Solid {
-    fn obj(self, parts: Vec<Part>, p: Params, surf: Option<Surface>) -> Obj {
+    /// `feat`: the object's patch features, kept for the slabs, which the contact refinement
+    /// may split.
+    fn obj(
+        self,
+        parts: Vec<Part>,
+        p: Params,
+        surf: Option<Surface>,
+        feat: Option<patches::Features>,
+    ) -> Obj {
         let slabs = parts.iter().filter(|q| !q.tris.is_empty()).count();
         Obj {
             parts,
-            // The slabs are patches the contact refinement may split.
-            feat: (self == Solid::StarOnSlabs).then(|| {
-                let s = surf.as_ref().expect("a solid has a surface");
-                patches::Features::new(s, p.merge_depth, p.d_max)
-            }),
+            feat: feat.filter(|_| self == Solid::StarOnSlabs),
             surf,
             params: Some(p),
             report: ObjectReport {
@@ -1576,9 +1580,12 @@ fn decompose_object(
         star(s, &p, opts, budget, &carried, None),
         Solid::Star,
     ));
+    // The patch features, built once for the slabs and the patches.
+    let mut feat = None;
     if whole.is_empty() && !carried.is_empty() {
+        let f = feat.insert(patches::Features::new(s, p.merge_depth, p.d_max));
         whole.extend(candidate(
-            star_on_slabs(s, &p, opts, budget, &carried),
+            star_on_slabs(s, &p, opts, budget, &carried, f),
             Solid::StarOnSlabs,
         ));
     }
@@ -1588,10 +1595,10 @@ fn decompose_object(
     }
     if let Some(k) = within(&whole) {
         let (_, parts, kind) = whole.swap_remove(k);
-        return kind.obj(parts, p, surf);
+        return kind.obj(parts, p, surf, feat);
     }
     let (fixed, rest) = convex_components(s, opts, budget);
-    let feat = patches::Features::new(s, p.merge_depth, p.d_max);
+    let feat = feat.unwrap_or_else(|| patches::Features::new(s, p.merge_depth, p.d_max));
     let run = |strategy: Strategy| {
         let p = Params::new(s, opts, strategy);
         let (parts, report) = grow_parts(s, &feat, &p, opts, &fixed, &rest, budget, effort, near);
@@ -1627,7 +1634,7 @@ fn decompose_object(
     if let Some(k) = closest(&whole, (5.0 * p.tol).max(reach * s.diag)) {
         if whole[k].0 < d_parts {
             let (_, parts, kind) = whole.swap_remove(k);
-            return kind.obj(parts, p, surf);
+            return kind.obj(parts, p, surf, Some(feat));
         }
     }
     Obj {
