@@ -1514,9 +1514,9 @@ fn decompose_alone(
 }
 
 /// [`decompose_alone`] on a prepared surface. `near[t]`: a lower bound on how far triangle
-/// `t` is from every neighbour's collision geometry, ∞ where it may not pin
-/// its patch (see [`free_passing_walls`]; empty: nothing is pinned); the rebalancing, the
-/// polishing and the refit leave alone the patches within reach of them.
+/// `t` is from every neighbour's collision geometry, ∞ where it may not pin its patch (see
+/// [`free_passing_walls`]; empty: nothing is pinned); the rebalancing, the polishing and the
+/// refit leave alone the patches within reach of them.
 fn decompose_object(
     surf: Option<Surface>,
     opts: &DecomposeOptions,
@@ -1741,8 +1741,7 @@ fn quality_loop(
 
 /// For each triangle of `s`, a lower bound on its distance to the neighbours' collision
 /// geometry (not the ground's: see [`decompose_scene_with`]). That is the distance from its
-/// centroid, less its
-/// circumradius about the centroid and, for a neighbour, the neighbour's tolerance (its hulls
+/// centroid, less its circumradius about the centroid and the neighbour's tolerance (its hulls
 /// may bulge that far past its surface). Triangles beyond a quarter of the diagonal from a
 /// neighbour's box skip its query. Second, the same over the neighbours that may rest on the
 /// triangle, those whose box centre lies above its centroid (see [`keeps_support`]).
@@ -2073,10 +2072,11 @@ fn decompose_scene_with(
 /// neighbour keeps `max_hulls/8` of it for the contact splits and the refinement (step 3),
 /// which often need few or none: the bowl holding the lemon of `00001` ended with 29 of its 32
 /// hulls and p95 1.75 % of the diagonal (1.64 % with the three left spent). When the object's
-/// hulls lie farther from the surface than the tolerance (p95), its free patches (not pinned, see `rebalance::pinned`, and not cut
-/// against a neighbour) go through the quality loop again up to `max_hulls`, then the
-/// polishing and the refit; the patches a neighbour may touch are left as they were. Returns
-/// whether any object changed (the refinement then runs again for the new hulls).
+/// hulls lie farther from the surface than the tolerance (p95), its free patches (not pinned,
+/// see `rebalance::pinned`, and not cut against a neighbour) go through the quality loop again
+/// up to `max_hulls`, then the polishing and the refit; the patches a neighbour may touch are
+/// left as they were. Returns whether any object changed (the refinement then runs again for
+/// the new hulls).
 fn top_up(objs: &mut [Obj], nears: &[(Vec<f64>, Vec<f64>)], opts: &DecomposeOptions) -> bool {
     let changed: Vec<bool> = objs
         .par_iter_mut()

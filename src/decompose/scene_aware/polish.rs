@@ -35,14 +35,14 @@
 //! the mug fixture (0.82, 0.46 since wall segments' seams are left out of their deviation) is
 //! within the tolerance and left as it is.
 //!
-//! Next to a neighbour, the patches within reach of it are pinned as in the rebalancing (see `rebalance::pinned`): never trimmed, merged, moved or
-//! split, and no move makes a new one, since they are the contact geometry the agreement tests
-//! hold. On the ten shared scenes (20,000 samples per object, before the solids got star
-//! pieces and V-HACD's hulls) this lowered p95 on 11 of 25 objects (the spoon of
-//! `00008_spoon_mug` 1.34 → 1.00 %, the bottle of `00009` 5.10 → 4.73 %, the lunch box
-//! 4.01 → 3.78 %), raised it on 4 by at most 0.02 points (unpolished objects whose neighbours'
-//! new hulls moved the cuts between them), and took the scenes' decomposition from 4.75 to
-//! 7.72 s in all.
+//! Next to a neighbour, the patches within reach of it are pinned as in the rebalancing (see
+//! `rebalance::pinned`): never trimmed, merged, moved or split, and no move makes a new one,
+//! since they are the contact geometry the agreement tests hold. On the ten shared scenes
+//! (20,000 samples per object, before the solids got star pieces and V-HACD's hulls) this
+//! lowered p95 on 11 of 25 objects (the spoon of `00008_spoon_mug` 1.34 → 1.00 %, the bottle
+//! of `00009` 5.10 → 4.73 %, the lunch box 4.01 → 3.78 %), raised it on 4 by at most 0.02
+//! points (unpolished objects whose neighbours' new hulls moved the cuts between them), and
+//! took the scenes' decomposition from 4.75 to 7.72 s in all.
 
 use super::geom::{sample_hull, Surface};
 use super::patches::Features;

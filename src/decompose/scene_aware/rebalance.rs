@@ -175,10 +175,10 @@ pub(super) fn rebalance(
     kept
 }
 
-/// Whether a patch (`tris`, its hull deviating `dev`) is within reach of a neighbour
-/// (`near`: per triangle, see `contact_distances`): its hull may bulge `dev` past
-/// its surface, a quarter more for sampling. Pinned patches are not merged, moved or split
-/// by the rebalancing.
+/// Whether a patch (`tris`, its hull deviating `dev`) is within reach of a neighbour (`near`:
+/// per triangle, see `contact_distances`): its hull may bulge `dev` past its surface, a
+/// quarter more for sampling. Pinned patches are not merged, moved or split by the
+/// rebalancing.
 pub(super) fn pinned(
     near: &[f64],
     tris: &[u32],
@@ -192,9 +192,9 @@ pub(super) fn pinned(
     }
 }
 
-/// How near a neighbour (`near`) a triangle of a patch whose hull deviates
-/// `dev` may touch it: the hull may bulge `dev` (at least the tolerance) past the surface, a
-/// quarter more for sampling.
+/// How near a neighbour (`near`) a triangle of a patch whose hull deviates `dev` may touch it:
+/// the hull may bulge `dev` (at least the tolerance) past the surface, a quarter more for
+/// sampling.
 pub(super) fn reach(dev: f64, p: &Params, opts: &DecomposeOptions) -> f64 {
     opts.clearance + 1.25 * dev.max(p.tol)
 }

@@ -35,9 +35,10 @@
 //!
 //! Star pieces grow the same way towards the mesh vertices outside them (see `star`).
 //!
-//! Patches within reach of a neighbour (the rebalancing's pins) are left as they are: what a neighbour rests on keeps the shape the contact splits are made for. One-sided
-//! patches too: their pushed copies already reach into the material, and rebuilding them
-//! changed nothing measurable.
+//! Patches within reach of a neighbour (the rebalancing's pins) are left as they are: what a
+//! neighbour rests on keeps the shape the contact splits are made for. One-sided patches too:
+//! their pushed copies already reach into the material, and rebuilding them changed nothing
+//! measurable.
 
 use super::geom::{sample_triangles, Surface};
 use super::rebalance::pinned;

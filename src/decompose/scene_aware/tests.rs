@@ -572,7 +572,8 @@ fn rebalancing_lowers_the_worst_deviation_at_the_same_budget() {
 }
 
 /// Next to a neighbour, the rebalancing and the polishing leave the patches the neighbour may
-/// touch exactly as the quality loop made them, and still rebalance the rest: a ball resting in the bowl, 0.75 mm above its floor.
+/// touch exactly as the quality loop made them, and still rebalance the rest: a ball resting
+/// in the bowl, 0.75 mm above its floor.
 #[test]
 fn rebalancing_next_to_a_neighbour_keeps_the_patches_it_may_touch() {
     let o = opts();
