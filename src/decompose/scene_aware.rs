@@ -877,6 +877,14 @@ fn star(
     let level = |h: &Hull| flat_over(s, p, support, h);
     let level = (!support.is_empty()).then_some(&level as &(dyn Fn(&Hull) -> bool + Sync));
     let (extra, floor) = slabs.unwrap_or((&[], f64::INFINITY));
+    // The pieces' hulls with the slabs: what the reach test and the 95th percentile measure.
+    let with_slabs = |pieces: &[(Hull, Vec<P3>, V3)]| -> Vec<Hull> {
+        pieces
+            .iter()
+            .map(|x| x.0.clone())
+            .chain(extra.iter().cloned())
+            .collect()
+    };
     let lowered = |q: &P3| {
         let r2 = (0.5 * p.tol).powi(2);
         q.z > floor
@@ -904,11 +912,7 @@ fn star(
                     .find_map(|bulge| {
                         geom::star_pieces(&v, &t, &c, opts.max_vertices, budget, bulge, level)
                     })?;
-                let hulls: Vec<Hull> = pieces
-                    .iter()
-                    .map(|x| x.0.clone())
-                    .chain(extra.iter().cloned())
-                    .collect();
+                let hulls = with_slabs(&pieces);
                 // The mesh within reach: what the rays could not see (a fold, a second lobe)
                 // sticks out.
                 let out = probes
@@ -927,12 +931,7 @@ fn star(
     // `max` is relative to the diagonal; a part's `dev` is a length.
     let (mut p95, mut max, mut pieces) = best;
     if grow_pieces(s, p, opts, &mut pieces, support, extra) {
-        let hulls: Vec<Hull> = pieces
-            .iter()
-            .map(|x| x.0.clone())
-            .chain(extra.iter().cloned())
-            .collect();
-        (p95, max) = distance_stats(s, &hulls)?;
+        (p95, max) = distance_stats(s, &with_slabs(&pieces))?;
     }
     let dev = max * s.diag;
     let parts = pieces
@@ -1045,21 +1044,23 @@ fn star_on_slabs(
                 .into_iter()
                 .filter_map(|g| build_part(s, &level, opts, g, Vec::new()))
                 .collect();
-            let mut stuck = vec![false; slabs.len()];
+            // Each slab's lift, and whether it is set aside (no split of it was found).
+            let mut lifts: Vec<(f64, bool)> = slabs.iter().map(|q| (lift(q), false)).collect();
             while slabs.len() < n {
                 let Some(w) = (0..slabs.len())
-                    .filter(|&i| !stuck[i] && lift(&slabs[i]) > level.tol)
-                    .max_by(|&i, &j| lift(&slabs[i]).total_cmp(&lift(&slabs[j])).then(j.cmp(&i)))
+                    .filter(|&i| !lifts[i].1 && lifts[i].0 > level.tol)
+                    .max_by(|&i, &j| lifts[i].0.total_cmp(&lifts[j].0).then(j.cmp(&i)))
                 else {
                     break;
                 };
                 match split(s, feat, &level, opts, &slabs[w], f64::INFINITY) {
                     Some((a, b)) => {
+                        lifts[w] = (lift(&a), false);
+                        lifts.push((lift(&b), false));
                         slabs[w] = a;
                         slabs.push(b);
-                        stuck.push(false);
                     }
-                    None => stuck[w] = true,
+                    None => lifts[w].1 = true,
                 }
             }
             let hulls = hulls_of(&slabs);

@@ -545,7 +545,7 @@ pub fn cone_pieces(
 /// face joins a patch only if no vertex of the patch then lies deeper than `bulge` under the
 /// piece's outer boundary, along its ray from `c` (so concave regions get smaller pieces), and
 /// the piece passes `accept` (if given; it must hold for a piece whenever it holds for a larger
-/// one, as the bulge does, see [`Growth::grow_checked`]).
+/// one, as the bulge does, see `Growth::grow_checked`).
 pub fn star_pieces(
     vertices: &[P3],
     triangles: &[[u32; 3]],
