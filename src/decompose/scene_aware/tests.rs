@@ -1005,6 +1005,61 @@ fn only_neighbours_above_a_triangle_may_rest_on_it() {
     assert_eq!(near, under);
 }
 
+/// What pins a patch (`pin_contacts`): a ball of 30 mm radius rests 0.05 mm above a wide
+/// slab (1 m: its tolerance pad, 1 % of its diagonal, is 14 mm) and 0.05 mm from a wall beside
+/// it. Its down-facing triangles are free; its steep ones within that pad of the slab but
+/// farther than the clearance from its surface (the lowest 2.8 mm above it) are free; those
+/// the wall touches stay pinned.
+#[test]
+fn a_patch_is_pinned_by_touched_walls_and_floors_in_reach_only() {
+    let o = opts();
+    let (r, gap) = (0.03, 5e-5);
+    let at = |m: Mesh, d: V3| Mesh::new(m.vertices.iter().map(|v| v + d).collect(), m.triangles);
+    let ball = Surface::new(&at(
+        shapes::uv_sphere(r, 64, 128),
+        V3::new(0.0, 0.0, r + gap),
+    ))
+    .unwrap();
+    let slab = at(
+        shapes::cuboid(V3::new(1.0, 1.0, 0.01)),
+        V3::new(0.0, 0.0, -0.005),
+    );
+    let wall = at(
+        shapes::cuboid(V3::new(0.01, 0.2, 0.2)),
+        V3::new(r + gap + 0.005, 0.0, 0.1),
+    );
+    let (slab, wall) = (Surface::new(&slab).unwrap(), Surface::new(&wall).unwrap());
+    let nbs = [&slab, &wall];
+    let (padded, _) = contact_distances(&ball, &nbs, &o);
+    let mut near = padded.clone();
+    pin_contacts(&ball, &nbs, &mut near, &o);
+    let n = |t: usize| ball.tri_normal[t];
+    let steep = |t: usize| n(t).z.abs() < SUPPORT_NZ;
+    // Down-facing triangles the slab was within reach of: all free.
+    let under: Vec<usize> = (0..near.len())
+        .filter(|&t| n(t).z <= -SUPPORT_NZ && padded[t].is_finite())
+        .collect();
+    assert!(!under.is_empty());
+    assert!(under.iter().all(|&t| near[t].is_infinite()));
+    // Steep triangles facing the slab, within its pad: free now.
+    let low: Vec<usize> = (0..near.len())
+        .filter(|&t| steep(t) && n(t).x < 0.5 && padded[t] <= o.clearance)
+        .collect();
+    assert!(low.len() >= 100, "{}", low.len());
+    assert!(low.iter().all(|&t| near[t].is_infinite()));
+    // The wall's contact: the steep triangles facing it at the equator stay pinned.
+    let touched = (0..near.len())
+        .filter(|&t| n(t).x > 0.99 && near[t] <= o.clearance)
+        .count();
+    assert!(touched >= 2, "{touched}");
+    // No steep triangle is pinned farther than its circumradius and the clearance from both.
+    for t in (0..near.len()).filter(|&t| steep(t) && near[t].is_finite()) {
+        let c = ball.tri_centroid[t];
+        let gap = slab.distance(&c).min(wall.distance(&c));
+        assert!(gap <= circumradius(&ball, t) + o.clearance, "{t}: {gap}");
+    }
+}
+
 /// Real solids: the YCB apple, filled by star pieces, where its 32 surface patches kept 24 % of
 /// its volume at p95 3.5 % of the diagonal (measured 0.46 %, volume 1.00); the pear, whose star
 /// pieces are within the tolerance (0.49 %) and kept without V-HACD, although V-HACD's hulls
