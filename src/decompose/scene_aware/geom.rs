@@ -108,9 +108,13 @@ impl Surface {
 
     /// Unsigned distance from `p` to the surface (parry's projection).
     pub fn distance(&self, p: &P3) -> f64 {
-        let q = to_dvec(p);
-        let proj = self.tri.project_point(&Pose::identity(), q, false);
-        (proj.point - q).length()
+        (self.closest(p) - p).norm()
+    }
+
+    /// The point of the surface closest to `p` (parry's projection).
+    pub fn closest(&self, p: &P3) -> P3 {
+        let proj = self.tri.project_point(&Pose::identity(), to_dvec(p), false);
+        crate::mesh::from_dvec(proj.point)
     }
 
     /// Whether some point of the surface is within `r` of `p`: the triangles of `p`'s grid

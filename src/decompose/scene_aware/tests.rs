@@ -1009,7 +1009,9 @@ fn only_neighbours_above_a_triangle_may_rest_on_it() {
 /// slab (1 m: its tolerance pad, 1 % of its diagonal, is 14 mm) and 0.05 mm from a wall beside
 /// it. Its down-facing triangles are free; its steep ones within that pad of the slab but
 /// farther than the clearance from its surface (the lowest 2.8 mm above it) are free; those
-/// the wall touches stay pinned.
+/// the wall touches stay pinned. A cylinder standing on the slab: its side triangles, which
+/// reach down to the slab, touch it only from above (free); a wall against its side pins
+/// those it touches.
 #[test]
 fn a_patch_is_pinned_by_touched_walls_and_floors_in_reach_only() {
     let o = opts();
@@ -1058,6 +1060,36 @@ fn a_patch_is_pinned_by_touched_walls_and_floors_in_reach_only() {
         let gap = slab.distance(&c).min(wall.distance(&c));
         assert!(gap <= circumradius(&ball, t) + o.clearance, "{t}: {gap}");
     }
+    let (rc, h) = (0.02, 0.04);
+    let cyl = at(
+        shapes::cylinder(rc, h, 64),
+        V3::new(0.0, 0.0, h / 2.0 + gap),
+    );
+    let cyl = Surface::new(&cyl).unwrap();
+    let sides: Vec<usize> = (0..cyl.tri_normal.len())
+        .filter(|&t| cyl.tri_normal[t].z.abs() < 0.1)
+        .collect();
+    // By distance alone every side triangle touches the slab.
+    assert!(sides
+        .iter()
+        .all(|&t| slab.distance(&cyl.tri_centroid[t]) <= circumradius(&cyl, t) + o.clearance));
+    let (mut near, _) = contact_distances(&cyl, &[&slab], &o);
+    pin_contacts(&cyl, &[&slab], &mut near, &o);
+    assert!(sides.iter().all(|&t| near[t].is_infinite()));
+    let wall = at(
+        shapes::cuboid(V3::new(0.01, 0.2, 0.2)),
+        V3::new(rc + gap + 0.005, 0.0, 0.1),
+    );
+    let wall = Surface::new(&wall).unwrap();
+    let (mut near, _) = contact_distances(&cyl, &[&slab, &wall], &o);
+    pin_contacts(&cyl, &[&slab, &wall], &mut near, &o);
+    let facing = |t: usize| cyl.tri_normal[t].x > 0.99;
+    assert!(sides.iter().any(|&t| facing(t) && near[t].is_finite()));
+    // Those facing away from it, farther from it than their circumradius (27 mm: they span the
+    // cylinder's height), stay free.
+    assert!(sides
+        .iter()
+        .all(|&t| cyl.tri_normal[t].x > -0.5 || near[t].is_infinite()));
 }
 
 /// Real solids: the YCB apple, filled by star pieces, where its 32 surface patches kept 24 % of
