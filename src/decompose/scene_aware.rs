@@ -427,8 +427,8 @@ impl Memo {
 ///   sneaker 2.41 against 2.10 %): their horizontal pair is arbitrary on a round object.
 ///
 /// Under a neighbour that also leans on its side (an up-facing triangle within reach of a
-/// neighbour that may rest on it, see `support`, and a steeper one within the clearance of a
-/// neighbour, see [`leaned_on`]) only `Patches` runs: its contact geometry is what the MuJoCo
+/// neighbour that may rest on it, see `support`, and a steeper one a neighbour touches from the
+/// side or above, see [`leaned_on`]) only `Patches` runs: its contact geometry is what the MuJoCo
 /// agreement tests hold, and the horizontal cuts put a seam under the pen of `pen_mug`
 /// leaning on its mug's rim (with both, Rapier's validation failed and MuJoCo turned the pen
 /// 7.8° in 2 s). An object that carries neighbours only on level triangles, or only rests on

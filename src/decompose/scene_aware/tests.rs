@@ -34,7 +34,6 @@ fn world_meshes(path: &Path) -> Vec<Mesh> {
     prep.objects.into_iter().map(|o| o.geometry).collect()
 }
 
-/// Independent check of the limits every hull must meet.
 /// A shared scene's world meshes and their decomposition at [`opts`]; `None` (the test is
 /// skipped) without `shared/`.
 fn shared_scene(name: &str) -> Option<(Vec<Mesh>, Vec<Vec<Hull>>, SceneAwareReport)> {
@@ -48,6 +47,7 @@ fn shared_scene(name: &str) -> Option<(Vec<Mesh>, Vec<Vec<Hull>>, SceneAwareRepo
     Some((meshes, hulls, rep))
 }
 
+/// Independent check of the limits every hull must meet.
 fn assert_limits(hulls: &[Hull], o: &DecomposeOptions) {
     assert!(
         !hulls.is_empty() && hulls.len() <= o.max_hulls,
@@ -1026,15 +1026,24 @@ fn a_patch_is_pinned_by_touched_walls_and_floors_in_reach_only() {
         shapes::cuboid(V3::new(1.0, 1.0, 0.01)),
         V3::new(0.0, 0.0, -0.005),
     );
-    let wall = at(
-        shapes::cuboid(V3::new(0.01, 0.2, 0.2)),
-        V3::new(r + gap + 0.005, 0.0, 0.1),
-    );
-    let (slab, wall) = (Surface::new(&slab).unwrap(), Surface::new(&wall).unwrap());
-    let nbs = [&slab, &wall];
-    let (padded, _) = contact_distances(&ball, &nbs, &o);
-    let mut near = padded.clone();
-    pin_contacts(&ball, &nbs, &mut near, &o);
+    let slab = Surface::new(&slab).unwrap();
+    // A 10 mm wall whose face is at x.
+    let wall_at = |x: f64| {
+        let m = at(
+            shapes::cuboid(V3::new(0.01, 0.2, 0.2)),
+            V3::new(x + 0.005, 0.0, 0.1),
+        );
+        Surface::new(&m).unwrap()
+    };
+    // The padded bounds (`contact_distances`) and what pins after `pin_contacts`.
+    let pins = |s: &Surface, nbs: &[&Surface]| {
+        let (padded, _) = contact_distances(s, nbs, &o);
+        let mut near = padded.clone();
+        pin_contacts(s, nbs, &mut near, &o);
+        (padded, near)
+    };
+    let wall = wall_at(r + gap);
+    let (padded, near) = pins(&ball, &[&slab, &wall]);
     let n = |t: usize| ball.tri_normal[t];
     let steep = |t: usize| n(t).z.abs() < SUPPORT_NZ;
     // Down-facing triangles the slab was within reach of: all free.
@@ -1073,16 +1082,9 @@ fn a_patch_is_pinned_by_touched_walls_and_floors_in_reach_only() {
     assert!(sides
         .iter()
         .all(|&t| slab.distance(&cyl.tri_centroid[t]) <= circumradius(&cyl, t) + o.clearance));
-    let (mut near, _) = contact_distances(&cyl, &[&slab], &o);
-    pin_contacts(&cyl, &[&slab], &mut near, &o);
+    let (_, near) = pins(&cyl, &[&slab]);
     assert!(sides.iter().all(|&t| near[t].is_infinite()));
-    let wall = at(
-        shapes::cuboid(V3::new(0.01, 0.2, 0.2)),
-        V3::new(rc + gap + 0.005, 0.0, 0.1),
-    );
-    let wall = Surface::new(&wall).unwrap();
-    let (mut near, _) = contact_distances(&cyl, &[&slab, &wall], &o);
-    pin_contacts(&cyl, &[&slab, &wall], &mut near, &o);
+    let (_, near) = pins(&cyl, &[&slab, &wall_at(rc + gap)]);
     let facing = |t: usize| cyl.tri_normal[t].x > 0.99;
     assert!(sides.iter().any(|&t| facing(t) && near[t].is_finite()));
     // Those facing away from it, farther from it than their circumradius (27 mm: they span the
