@@ -16,7 +16,8 @@
 //! `--quick`: three small fixture meshes (CI). `--ref-dir DIR`: keep (and resume) the Python
 //! reference runs in DIR (with `--no-python`: only read its `results.json`). `--repeat N`: our
 //! engine's time is the median of N runs, which must all give the same hulls. `--max-hulls N`:
-//! our engine's hull budget (default 32; CoACD 32×64 keeps 32). Without the Python packages the reference columns read "n/a".
+//! our engine's hull budget (default 32; CoACD 32×64 and V-HACD 4 keep 32). Without the
+//! Python packages the reference columns read "n/a".
 
 use interact3d::decompose::scene_aware::{metrics, SceneAware};
 use interact3d::decompose::{vhacd, DecomposeOptions, Hull};

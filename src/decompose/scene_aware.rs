@@ -46,12 +46,12 @@
 //!    vertex normal by `clamp(0.45 × local thickness, 1.5·min_thickness, tolerance/2)`. Either
 //!    way a hull lies in the material except for the sagitta where it bridges a concave side,
 //!    so cavities stay open, and it has at most `max_vertices` vertices. Quality loop: from
-//!    half the budget (at most 16 patches), the patch whose hull deviates most from the mesh (max of sampled
-//!    distances; for a wall segment, not those inside the material, which are seams with the
-//!    segments beside it: see [`deviation`]) is split while that exceeds the tolerance and the
-//!    budget lasts; a split tries
-//!    2-means and area-median cuts across the two PCA axes and keeps the one whose worse half
-//!    deviates least. Objects with neighbours keep `max_hulls/8` of the budget for step 3.
+//!    half the budget (at most 16 patches), the patch whose hull deviates most from the mesh
+//!    (max of sampled distances; for a wall segment, not those inside the material, which are
+//!    seams with the segments beside it: see [`deviation`]) is split while that exceeds the
+//!    tolerance and the budget lasts; a split tries 2-means and area-median cuts across the
+//!    two PCA axes and keeps the one whose worse half deviates least. Objects with neighbours
+//!    keep `max_hulls/8` of the budget for step 3.
 //!    Once the budget is spent the patches are rebalanced and polished (`rebalance.rs`,
 //!    `polish.rs`: moves that bring the far tail of the surface distance closer, where the
 //!    loop above chases each hull's maximum), next to neighbours with the patches they may
