@@ -177,7 +177,8 @@ struct ExportArgs {
     build: BuildArgs,
     #[command(flatten)]
     limits: LimitsArgs,
-    /// Folder of templates overriding the built-in ones (scene.xml.j2, object.xml.j2, object.urdf.j2).
+    /// Folder of templates overriding the built-in ones (scene.xml.j2, object.xml.j2,
+    /// object.urdf.j2).
     #[arg(long)]
     templates: Option<PathBuf>,
     /// Replace OUT even if it is not an earlier interact3d export.

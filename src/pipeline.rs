@@ -70,7 +70,8 @@ pub fn export_scene(scene: &Path, out: &Path, job: &ExportJob) -> Result<Exporte
     Ok(Exported { report, validation })
 }
 
-/// Validate a scene, or an export folder (its hulls and inertials as written, from its initial poses).
+/// Validate a scene, or an export folder (its hulls and inertials as written, from its initial
+/// poses).
 pub fn validate_path(
     path: &Path,
     limits: &Limits,

@@ -788,7 +788,8 @@ mod tests {
 
     #[test]
     fn revolve_exact_volume_and_closed() {
-        // A hollow cylinder cup with a pole at the top of the cavity? Use a lens: poles on both ends.
+        // A hollow cylinder cup with a pole at the top of the cavity? Use a lens: poles on both
+        // ends.
         let profile = [[0.0, 0.0], [1.0, 0.5], [1.0, 1.5], [0.0, 2.0]];
         let m = revolve(&profile, 24);
         assert!(m.is_closed());

@@ -1,6 +1,7 @@
 //! Interoperability: every export loads in MuJoCo and PyBullet as it is, with the bodies, geoms,
 //! masses and inertias the report promises, and 1 s of simulation stays finite.
-//! Needs Python with `mujoco` and `pybullet` (tests/python/requirements.txt; .ci/run installs them).
+//! Needs Python with `mujoco` and `pybullet` (tests/python/requirements.txt; .ci/run installs
+//! them).
 
 mod common;
 use common::*;

@@ -11,8 +11,8 @@
 //!    weighted when both meshes carry colour, [`colour`]);
 //! 4. scale-aware trimmed ICP with Umeyama and a bounded scale ([`icp`]);
 //! 5. collision-aware refinement of every further object against the fixed, already composed
-//!    objects' signed distance field ([`sdf`], [`refine`](mod@refine)); objects are added one at a time, the
-//!    composed scene becoming the new anchor.
+//!    objects' signed distance field ([`sdf`], [`refine`](mod@refine)); objects are added one
+//!    at a time, the composed scene becoming the new anchor.
 //!
 //! Everything is deterministic for a seed. [`synth`] makes guidance parts from ground-truth
 //! scenes for tests and the benchmark; [`folder`] reads sample folders and writes the output.

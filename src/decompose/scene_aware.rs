@@ -1867,12 +1867,12 @@ fn circumradius(s: &Surface, t: usize) -> f64 {
 const SUPPORT_NZ: f64 = 0.9;
 
 /// Refine where the neighbours rest, before any cut: a patch hull whose bulge (its chord over a
-/// concave side, up to the tolerance) could reach a neighbour resting on it is split, worst first, while
-/// the object's budget lasts, until its deviation is below `CONTACT_DEV` of the tolerance. A
-/// ball on a bowl's flat floor otherwise rests on the chords of the two patches that span the
-/// floor and the rising wall: a groove 0.1–0.3 mm above the floor, tilted 1–2°, in which each
-/// engine finds a different rest (Rapier and MuJoCo 2.5 mm apart). Pairs whose meshes
-/// interpenetrate are left to the cuts.
+/// concave side, up to the tolerance) could reach a neighbour resting on it is split, worst
+/// first, while the object's budget lasts, until its deviation is below `CONTACT_DEV` of the
+/// tolerance. A ball on a bowl's flat floor otherwise rests on the chords of the two patches
+/// that span the floor and the rising wall: a groove 0.1–0.3 mm above the floor, tilted 1–2°,
+/// in which each engine finds a different rest (Rapier and MuJoCo 2.5 mm apart). Pairs whose
+/// meshes interpenetrate are left to the cuts.
 fn contact_splits(
     objs: &mut [Obj],
     pairs: &[(usize, usize)],

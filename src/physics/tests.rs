@@ -363,8 +363,8 @@ fn a_plate_of_pie_slices_resting_on_the_floor_stays_put() {
     assert!(b.settle_rotation_deg < 0.01, "{}", b.settle_rotation_deg);
 }
 
-/// Scanned objects rest on the floor, and on a box, instead of sinking into it: a flat package (GSO,
-/// one 64-vertex hull whose bottom is many nearly coplanar small faces) and a fork (YCB, 10
+/// Scanned objects rest on the floor, and on a box, instead of sinking into it: a flat package
+/// (GSO, one 64-vertex hull whose bottom is many nearly coplanar small faces) and a fork (YCB, 10
 /// thin hulls, 20 g). With parry's reuse of last step's contact points against the box floor,
 /// the package sank 1–3.7 mm (rest check failed at 7.5 mm; MuJoCo holds it within 1.2 mm and
 /// 0.6°); on a half-space floor, whose manifold takes the hull face closest to facing straight
