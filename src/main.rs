@@ -153,7 +153,7 @@ struct BuildArgs {
     #[arg(long, value_enum, default_value_t = Engine::SceneAware)]
     engine: Engine,
     /// Most convex hulls per object.
-    #[arg(long, default_value_t = 32)]
+    #[arg(long, default_value_t = interact3d::decompose::DEFAULT_MAX_HULLS)]
     max_hulls: usize,
     /// Most vertices per hull (PhysX/Isaac accept 64).
     #[arg(long, default_value_t = 64)]

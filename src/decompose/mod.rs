@@ -14,6 +14,9 @@ pub use hull::Hull;
 use crate::error::Result;
 use crate::mesh::Mesh;
 
+/// The default hull budget per object (`DecomposeOptions::max_hulls`, `--max-hulls`).
+pub const DEFAULT_MAX_HULLS: usize = 32;
+
 /// Limits every decomposition meets.
 #[derive(Clone, Debug, PartialEq)]
 pub struct DecomposeOptions {
@@ -39,7 +42,7 @@ pub struct DecomposeOptions {
 impl Default for DecomposeOptions {
     fn default() -> Self {
         DecomposeOptions {
-            max_hulls: 32,
+            max_hulls: DEFAULT_MAX_HULLS,
             max_vertices: 64,
             min_thickness: 2e-4,
             resolution: 64,

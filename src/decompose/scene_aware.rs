@@ -460,7 +460,7 @@ impl Strategy {
     /// worse: from `budget/2` patches the mug fixture read 0.70 % of the diagonal with 47
     /// hulls at 48, against 0.46 % with 26 at 32.
     fn initial_patches(self, budget: usize) -> usize {
-        let b = budget.min(DecomposeOptions::default().max_hulls);
+        let b = budget.min(super::DEFAULT_MAX_HULLS);
         match self {
             Strategy::Patches => (b / 2).max(1),
             Strategy::Planes => (b / 16).max(1),
