@@ -163,14 +163,15 @@ fn main() {
     let args: Vec<String> = std::env::args().collect();
     let quick = args.iter().any(|a| a == "--quick");
     let no_python = args.iter().any(|a| a == "--no-python");
+    // The word after `flag` (as `bench_compose` reads its options).
+    let value = |flag: &str| -> Option<&String> {
+        args.iter()
+            .position(|a| a == flag)
+            .and_then(|i| args.get(i + 1))
+    };
     // `--max-hulls N`: our engine's hull budget (default 32); the reference engines keep theirs.
     let mut opts = DecomposeOptions::default();
-    if let Some(n) = args
-        .iter()
-        .position(|a| a == "--max-hulls")
-        .and_then(|i| args.get(i + 1))
-        .and_then(|n| n.parse().ok())
-    {
+    if let Some(n) = value("--max-hulls").and_then(|n| n.parse().ok()) {
         opts.max_hulls = n;
     }
 
@@ -224,21 +225,14 @@ fn main() {
     let tmp_dir = tempfile::tempdir().expect("temp dir");
     // `--ref-dir DIR`: keep the reference runs there (the Python runner resumes: CoACD takes
     // minutes on a scan).
-    let ref_dir: Option<PathBuf> = args
-        .iter()
-        .position(|a| a == "--ref-dir")
-        .and_then(|i| args.get(i + 1))
-        .map(PathBuf::from);
+    let ref_dir: Option<PathBuf> = value("--ref-dir").map(PathBuf::from);
     if let Some(d) = &ref_dir {
         std::fs::create_dir_all(d).expect("create --ref-dir");
     }
     let tmp: &Path = ref_dir.as_deref().unwrap_or(tmp_dir.path());
     // `--repeat N`: time our engine N times and report the median (this machine's timings
     // vary by 10-20 % from run to run); every run must give the same hulls.
-    let repeat: usize = args
-        .iter()
-        .position(|a| a == "--repeat")
-        .and_then(|i| args.get(i + 1))
+    let repeat: usize = value("--repeat")
         .and_then(|n| n.parse().ok())
         .unwrap_or(1)
         .max(1);
