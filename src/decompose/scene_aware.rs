@@ -101,7 +101,7 @@ use std::sync::Mutex;
 /// Engine name, recorded in reports and in the cache key.
 pub const NAME: &str = "scene_aware";
 /// Bumped whenever the output for the same input changes (invalidates the cache).
-pub const VERSION: u32 = 31;
+pub const VERSION: u32 = 32;
 
 /// What happened to one object.
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
@@ -1803,8 +1803,9 @@ const CONTACT_DEV: f64 = 0.1;
 
 /// Which triangles pin their patch (see `rebalance::pinned`); the others get `near = ∞`:
 ///
-/// - an up-facing level one (normal within about 25° of +Z: a floor something stands on),
-///   wherever a neighbour is within reach of its hull (`near`);
+/// - an up-facing level one (normal within about 25° of +Z: a floor something stands on)
+///   where a neighbour lies over it (its nearest point above the triangle's centroid and
+///   within its circumradius horizontally) and within reach of its hull (`near`);
 /// - a steep one only where a neighbour's surface touches it (within the clearance of the
 ///   triangle itself: its centroid's distance less its circumradius) from the side or from
 ///   above (a pen leaning on a mug's rim), not from below;
@@ -1831,22 +1832,43 @@ const CONTACT_DEV: f64 = 0.1;
 /// and MuJoCo moves each sneaker at most 0.36 mm and 0.19° over 2 s from its settled pose.
 /// No longer leaned on (see [`leaned_on`]), the second sneaker of `00005` runs both strategies
 /// and takes the plane cuts, which leave more of it uncovered (9.5 → 15.3 %).
+///
+/// An up-facing triangle used to pin wherever a neighbour was within reach of its hull, beside
+/// it as well as over it: the level tops of a sneaker's sole and upper next to the sneaker
+/// beside it, a mug's rim and floor ring next to the ball in it. Pinned only under a
+/// neighbour, the sum fell 25.85 → 23.87 (the second sneaker of `00005` 2.55 → 1.31 %, the
+/// first 1.18 → 1.05 %, the third 1.10 → 1.18 %; the shoe of `00004` 1.12 → 1.02 %, the ball
+/// mug 2.80 → 2.33 %, the spoon mug 1.70 → 1.58 %), with 0 overlaps; the ten scenes'
+/// decomposition took 15.9 → 18.2 s, the freed patches being rebalanced and polished. The
+/// fixtures' hulls are unchanged, every shared scene still passes validation, and over 2 s
+/// MuJoCo moves no body more than 0.09 mm or 0.10° further than before.
 fn pin_contacts(s: &Surface, nbs: &[&Surface], near: &mut [f64], opts: &DecomposeOptions) {
     near.par_iter_mut().enumerate().for_each(|(t, d)| {
-        let nz = s.tri_normal[t].z;
-        if nz >= SUPPORT_NZ || d.is_infinite() {
+        if d.is_infinite() {
             return;
         }
-        let touched = nz > -SUPPORT_NZ && *d <= opts.clearance && {
-            let c = s.tri_centroid[t];
-            let reach = circumradius(s, t) + opts.clearance;
+        let nz = s.tri_normal[t].z;
+        let c = s.tri_centroid[t];
+        let pins = if nz >= SUPPORT_NZ {
+            // A neighbour over the triangle: its nearest point within the triangle's
+            // circumradius of the centroid horizontally, and not below it (less the clearance,
+            // so that one level with it, beside it, pins whatever the rounding).
+            let r = circumradius(s, t);
             nbs.iter().any(|nb| {
                 let u = nb.closest(&c) - c;
-                let gap = u.norm();
-                gap <= reach && u.z > -SUPPORT_NZ * gap
+                u.z >= -opts.clearance && u.x.hypot(u.y) <= r
             })
+        } else {
+            nz > -SUPPORT_NZ && *d <= opts.clearance && {
+                let reach = circumradius(s, t) + opts.clearance;
+                nbs.iter().any(|nb| {
+                    let u = nb.closest(&c) - c;
+                    let gap = u.norm();
+                    gap <= reach && u.z > -SUPPORT_NZ * gap
+                })
+            }
         };
-        if !touched {
+        if !pins {
             *d = f64::INFINITY;
         }
     });

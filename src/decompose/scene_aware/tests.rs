@@ -1114,6 +1114,79 @@ fn a_patch_is_pinned_by_touched_walls_and_floors_in_reach_only() {
         .all(|&t| cyl.tri_normal[t].x > -0.5 || near[t].is_infinite()));
 }
 
+/// A floor pins only under a neighbour (`pin_contacts`). A puck 200 mm wide, its top in
+/// 5 mm rings: a tall wall touching its side comes within reach (`rebalance::reach`, the
+/// puck's tolerance 2.8 mm) of the top triangles up to about 10 mm from it, but lies over none
+/// of them; those farther from it than their circumradius are freed. A cube resting on the
+/// top, 0.05 mm above it, pins every top triangle under it.
+#[test]
+fn a_floor_pins_under_a_neighbour_not_beside_one() {
+    let o = opts();
+    let (rp, top, gap) = (0.1, 0.02, 5e-5);
+    let mut profile = vec![[rp, 0.0], [rp, top]];
+    profile.extend((1..20).map(|k| [rp - 0.005 * k as f64, top]));
+    let puck = Surface::new(&shapes::revolve(&profile, 128)).unwrap();
+    let p = Params::new(&puck, &o, Strategy::Patches);
+    let at = |m: Mesh, d: V3| Mesh::new(m.vertices.iter().map(|v| v + d).collect(), m.triangles);
+    let wall = at(
+        shapes::cuboid(V3::new(0.01, 0.2, 0.2)),
+        V3::new(rp + gap + 0.005, 0.0, 0.1),
+    );
+    let wall = Surface::new(&wall).unwrap();
+    let cube = at(
+        shapes::cuboid(V3::new(0.03, 0.03, 0.03)),
+        V3::new(0.0, 0.0, top + gap + 0.015),
+    );
+    let cube = Surface::new(&cube).unwrap();
+    let pins = |nbs: &[&Surface]| {
+        let (padded, _) = contact_distances(&puck, nbs, &o);
+        let mut near = padded.clone();
+        pin_contacts(&puck, nbs, &mut near, &o);
+        (padded, near)
+    };
+    let tops: Vec<usize> = (0..puck.tri_normal.len())
+        .filter(|&t| puck.tri_normal[t].z > 0.99)
+        .collect();
+    let reach = rebalance::reach(p.tol, &p, &o);
+    let (padded, near) = pins(&[&wall]);
+    let in_reach: Vec<usize> = tops
+        .iter()
+        .copied()
+        .filter(|&t| padded[t] <= reach)
+        .collect();
+    assert!(in_reach.len() >= 20, "{}", in_reach.len());
+    let freed: Vec<usize> = in_reach
+        .iter()
+        .copied()
+        .filter(|&t| near[t].is_infinite())
+        .collect();
+    assert!(
+        freed.len() * 2 >= in_reach.len(),
+        "{} of {}",
+        freed.len(),
+        in_reach.len()
+    );
+    // Pinned only within their circumradius of the wall, horizontally.
+    for &t in &in_reach {
+        let c = puck.tri_centroid[t];
+        let beside = rp + gap - c.x <= circumradius(&puck, t);
+        assert_eq!(near[t].is_finite(), beside, "{t}: {c:?}");
+    }
+    let (padded, near) = pins(&[&cube]);
+    let under: Vec<usize> = tops
+        .iter()
+        .copied()
+        .filter(|&t| {
+            let c = puck.tri_centroid[t];
+            c.x.abs() < 0.015 && c.y.abs() < 0.015
+        })
+        .collect();
+    assert!(under.len() >= 4, "{}", under.len());
+    assert!(under
+        .iter()
+        .all(|&t| near[t] == padded[t] && near[t] <= reach));
+}
+
 /// Real solids: the YCB apple, filled by star pieces, where its 32 surface patches kept 24 % of
 /// its volume at p95 3.5 % of the diagonal (measured 0.46 %, volume 1.00); the pear, whose star
 /// pieces are within the tolerance (0.49 %) and kept without V-HACD, although V-HACD's hulls
