@@ -300,9 +300,56 @@ fn real_scenes_hulls_apart() {
     }
 }
 
-/// A bowl holding a lemon needs one of the four hulls kept back for its neighbour: the rest
-/// goes to its free patches, closer to its surface, and the hulls the lemon may touch stay as
-/// they were.
+/// A neighbour hovering over a floor within the tolerance lands on it, so the contact splits
+/// reach it (`contact_splits`). The ball of `ball_bowl` lifted 0.8 of the bowl's tolerance
+/// above its composed pose (1.9 mm): the floor is still split under it, and the hull straight
+/// below its lowest point is level within 1° (0.65°; 5.3° when the splits stopped at the
+/// hulls' own reach, where a patch spanning floor and wall tilted it).
+#[test]
+fn a_neighbour_hovering_within_the_tolerance_is_split_under() {
+    let o = opts();
+    let meshes = world_meshes(&fixture("ball_bowl"));
+    let (bowl, ball) = (&meshes[0], &meshes[1]);
+    let tol = o.tolerance * bowl.aabb().unwrap().diagonal();
+    let lifted = Mesh::new(
+        ball.vertices
+            .iter()
+            .map(|v| v + V3::new(0.0, 0.0, 0.8 * tol))
+            .collect(),
+        ball.triangles.clone(),
+    );
+    let (hulls, rep) = decompose_scene(&[bowl, &lifted], &o);
+    assert!(rep.objects[0].neighbour_splits > 0, "{:?}", rep.objects[0]);
+    let low = lifted
+        .vertices
+        .iter()
+        .min_by(|a, b| a.z.total_cmp(&b.z))
+        .unwrap();
+    // The top face of each hull the vertical line through `low` crosses, at that line.
+    let top = |h: &Hull| {
+        let mut best: Option<(f64, V3)> = None;
+        for (n, d) in &h.planes {
+            if n.z > 1e-6 {
+                let z = (d - n.x * low.x - n.y * low.y) / n.z;
+                if best.is_none_or(|b| z < b.0) {
+                    best = Some((z, *n));
+                }
+            }
+        }
+        best.filter(|(z, _)| h.contains(&P3::new(low.x, low.y, z - 1e-7)))
+    };
+    let (z, n) = hulls[0]
+        .iter()
+        .filter_map(top)
+        .max_by(|a, b| a.0.total_cmp(&b.0))
+        .expect("a hull under the ball");
+    assert!(z < low.z, "{z} above the ball's lowest point {}", low.z);
+    let tilt = n.z.acos().to_degrees();
+    assert!(tilt <= 1.0, "the floor under the ball tilts {tilt:.2}°");
+}
+
+/// The shoe on the tray of `00004` needs none of the four hulls kept back for its neighbour:
+/// they go to its free patches, closer to its surface, and the tray is left as it was.
 #[test]
 fn what_the_neighbours_leave_of_the_budget_is_spent() {
     let Some(sh) = shared() else {
@@ -310,41 +357,22 @@ fn what_the_neighbours_leave_of_the_budget_is_spent() {
         return;
     };
     let o = opts();
-    let meshes = world_meshes(&sh.join("datasets/scenes/food/00001_lemon_bowl"));
+    let meshes = world_meshes(&sh.join("datasets/scenes/apparel/00004_shoe_tray"));
     let refs: Vec<&Mesh> = meshes.iter().collect();
     let (kept, r_kept) = decompose_scene_with(&refs, &o, false);
     let (spent, r_spent) = decompose_scene(&refs, &o);
-    let (r0, r1) = (&r_kept.objects[0], &r_spent.objects[0]);
-    let left = o.max_hulls - kept[0].len();
+    let (r0, r1) = (&r_kept.objects[1], &r_spent.objects[1]);
+    let left = o.max_hulls - kept[1].len();
     assert!(left > 0 && r0.neighbour_splits < o.max_hulls / 8, "{r0:?}");
-    assert_eq!(spent[0].len(), o.max_hulls);
+    assert_eq!(spent[1].len(), o.max_hulls);
     assert_eq!(r1.topped_up, left);
-    assert_eq!(
-        kept[1], spent[1],
-        "the lemon (star pieces) is left as it is"
-    );
+    assert_eq!(kept[0], spent[0], "the tray is left as it is");
     assert_eq!(deepest_cross_overlap(&spent), 0.0);
-    assert_limits(&spent[0], &o);
-    let p95 = |h: &[Hull]| metrics::measure(&meshes[0], h).dist_p95;
-    let (before, after) = (p95(&kept[0]), p95(&spent[0]));
-    eprintln!("bowl p95 {:.3} % -> {:.3} %", before * 100.0, after * 100.0);
+    assert_limits(&spent[1], &o);
+    let p95 = |h: &[Hull]| metrics::measure(&meshes[1], h).dist_p95;
+    let (before, after) = (p95(&kept[1]), p95(&spent[1]));
+    eprintln!("shoe p95 {:.3} % -> {:.3} %", before * 100.0, after * 100.0);
     assert!(after <= 0.95 * before, "{before} -> {after}");
-    // Every hull within reach of the lemon's (the bulge a hull may have, see
-    // `rebalance::reach`, with the tolerance of the bowl's diagonal) is still there.
-    let diag = meshes[0].aabb().unwrap().diagonal();
-    let reach = o.clearance + 1.25 * o.tolerance * diag;
-    let others: Vec<ConvexPolyhedron> = kept[1].iter().filter_map(geom::polyhedron).collect();
-    let touching: Vec<&Hull> = kept[0]
-        .iter()
-        .filter(|h| {
-            let x = geom::polyhedron(h).unwrap();
-            others.iter().any(|t| geom::distance(&x, t) < reach)
-        })
-        .collect();
-    assert!(!touching.is_empty(), "the floor under the lemon at least");
-    for h in touching {
-        assert!(spent[0].contains(h), "a hull the lemon may touch changed");
-    }
 }
 
 /// The lunch box of `00009` carries a bottle on a lid that undulates by 4 mm: its star pieces
