@@ -1804,8 +1804,9 @@ const CONTACT_DEV: f64 = 0.1;
 /// Which triangles pin their patch (see `rebalance::pinned`); the others get `near = ∞`:
 ///
 /// - an up-facing level one (normal within about 25° of +Z: a floor something stands on)
-///   where a neighbour lies over it (its nearest point above the triangle's centroid and
-///   within its circumradius horizontally) and within reach of its hull (`near`);
+///   where a neighbour lies over it (its nearest point within the triangle's circumradius of
+///   the centroid horizontally, and not below it by more than the clearance) and within reach
+///   of its hull (`near`);
 /// - a steep one only where a neighbour's surface touches it (within the clearance of the
 ///   triangle itself: its centroid's distance less its circumradius) from the side or from
 ///   above (a pen leaning on a mug's rim), not from below;
@@ -2146,14 +2147,13 @@ fn decompose_scene_with(
 /// Step 3b: spend what the neighbours left of each object's budget. An object next to a
 /// neighbour keeps `max_hulls/8` of it for the contact splits and the refinement (step 3),
 /// which often need few or none: the shoe on the tray of `00004` needs none and spends all
-/// four here (the bowl holding the lemon of `00001` ended with 29 of its 32 hulls and p95
+/// four here. (The bowl holding the lemon of `00001` ended with 29 of its 32 hulls and p95
 /// 1.75 % of the diagonal, 1.64 % with the three left spent, until its contact splits reached
-/// the lemon hovering above its floor). When the object's
-/// hulls lie farther from the surface than the tolerance (p95), its free patches (not pinned,
-/// see `rebalance::pinned`, and not cut against a neighbour) go through the quality loop again
-/// up to `max_hulls`, then the polishing and the refit; the patches a neighbour may touch are
-/// left as they were. Returns whether any object changed (the refinement then runs again for
-/// the new hulls).
+/// the lemon hovering above its floor.) When the object's hulls lie farther from the surface
+/// than the tolerance (p95), its free patches (not pinned, see `rebalance::pinned`, and not
+/// cut against a neighbour) go through the quality loop again up to `max_hulls`, then the
+/// polishing and the refit; the patches a neighbour may touch are left as they were. Returns
+/// whether any object changed (the refinement then runs again for the new hulls).
 fn top_up(objs: &mut [Obj], nears: &[(Vec<f64>, Vec<f64>)], opts: &DecomposeOptions) -> bool {
     let changed: Vec<bool> = objs
         .par_iter_mut()
