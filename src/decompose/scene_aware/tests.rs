@@ -14,6 +14,11 @@ fn opts() -> DecomposeOptions {
     DecomposeOptions::default()
 }
 
+/// `m` moved by `d`.
+fn moved(m: &Mesh, d: V3) -> Mesh {
+    m.transformed(&nalgebra::Translation3::from(d).to_homogeneous())
+}
+
 fn fixture(name: &str) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR"))
         .join("fixtures")
@@ -311,13 +316,7 @@ fn a_neighbour_hovering_within_the_tolerance_is_split_under() {
     let meshes = world_meshes(&fixture("ball_bowl"));
     let (bowl, ball) = (&meshes[0], &meshes[1]);
     let tol = o.tolerance * bowl.aabb().unwrap().diagonal();
-    let lifted = Mesh::new(
-        ball.vertices
-            .iter()
-            .map(|v| v + V3::new(0.0, 0.0, 0.8 * tol))
-            .collect(),
-        ball.triangles.clone(),
-    );
+    let lifted = moved(ball, V3::new(0.0, 0.0, 0.8 * tol));
     let (hulls, rep) = decompose_scene(&[bowl, &lifted], &o);
     assert!(rep.objects[0].neighbour_splits > 0, "{:?}", rep.objects[0]);
     let low = lifted
@@ -1033,15 +1032,7 @@ fn an_avocado_half_on_a_plate_is_filled_by_star_pieces() {
 #[test]
 fn only_neighbours_above_a_triangle_may_rest_on_it() {
     let o = opts();
-    let lift = |m: Mesh, dz: f64| {
-        Mesh::new(
-            m.vertices
-                .iter()
-                .map(|v| v + V3::new(0.0, 0.0, dz))
-                .collect(),
-            m.triangles,
-        )
-    };
+    let lift = |m: Mesh, dz: f64| moved(&m, V3::new(0.0, 0.0, dz));
     let body = Surface::new(&lift(shapes::cuboid(V3::new(0.04, 0.04, 0.02)), 0.03)).unwrap();
     let slab = |dz: f64| Surface::new(&lift(shapes::cuboid(V3::new(0.1, 0.1, 0.01)), dz)).unwrap();
     let (below, above) = (slab(0.0149), slab(0.0451));
@@ -1064,7 +1055,7 @@ fn only_neighbours_above_a_triangle_may_rest_on_it() {
 fn a_patch_is_pinned_by_touched_walls_and_floors_in_reach_only() {
     let o = opts();
     let (r, gap) = (0.03, 5e-5);
-    let at = |m: Mesh, d: V3| Mesh::new(m.vertices.iter().map(|v| v + d).collect(), m.triangles);
+    let at = |m: Mesh, d: V3| moved(&m, d);
     let ball = Surface::new(&at(
         shapes::uv_sphere(r, 64, 128),
         V3::new(0.0, 0.0, r + gap),
@@ -1155,7 +1146,7 @@ fn a_floor_pins_under_a_neighbour_not_beside_one() {
     profile.extend((1..20).map(|k| [rp - 0.005 * k as f64, top]));
     let puck = Surface::new(&shapes::revolve(&profile, 128)).unwrap();
     let p = Params::new(&puck, &o, Strategy::Patches);
-    let at = |m: Mesh, d: V3| Mesh::new(m.vertices.iter().map(|v| v + d).collect(), m.triangles);
+    let at = |m: Mesh, d: V3| moved(&m, d);
     let wall = at(
         shapes::cuboid(V3::new(0.01, 0.2, 0.2)),
         V3::new(rp + gap + 0.005, 0.0, 0.1),
