@@ -26,10 +26,7 @@ fn load_obj(path: &str) -> Option<Mesh> {
     let mut m = Mesh::default();
     for model in models {
         let p = &model.mesh.positions;
-        let verts = p
-            .chunks(3)
-            .map(|c| P3::new(c[0] as f64, c[1] as f64, c[2] as f64))
-            .collect();
+        let verts = p.chunks(3).map(|c| P3::new(c[0], c[1], c[2])).collect();
         let tris = model
             .mesh
             .indices

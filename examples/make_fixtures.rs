@@ -702,7 +702,7 @@ fn write_obj(dir: &Path, name: &str, visual: &VisualMesh) {
     let pos: Vec<P3> = tm
         .positions
         .chunks(3)
-        .map(|c| P3::new(c[0] as f64, c[1] as f64, c[2] as f64))
+        .map(|c| P3::new(c[0], c[1], c[2]))
         .collect();
     let tris = tm.indices.chunks(3).map(|c| [c[0], c[1], c[2]]).collect();
     let back = Mesh::new(pos, tris).welded(0.0);

@@ -6,6 +6,12 @@
 //! [`prepare`] (metres, Z-up, on the ground) → [`decompose`] (convex hulls) → [`inertia`] →
 //! [`export`] (MJCF, URDF) → [`metrics`] and [`physics`] (validation).
 
+// `!(x > 0.0)` is written on purpose throughout: unlike `x <= 0.0` it is also true for NaN,
+// so a guard written that way rejects NaN input too.
+#![allow(clippy::neg_cmp_op_on_partial_ord)]
+// Coordinate loops (`for k in 0..3`) index several arrays in step; that reads better than zips.
+#![allow(clippy::needless_range_loop)]
+
 pub mod batch;
 pub mod body;
 pub mod compose;

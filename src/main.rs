@@ -305,7 +305,6 @@ fn run(cli: Cli) -> Result<ExitCode, Error> {
                 validate: (!a.no_validate).then(|| a.check.options()),
                 keep_composed_pose: a.keep_composed_pose,
                 fix_penetration: a.fix_penetration,
-                ..Default::default()
             };
             let t = std::time::Instant::now();
             let done = interact3d::pipeline::export_scene(&a.scene, &a.out, &job)?;

@@ -218,7 +218,7 @@ impl Mesh {
     /// Vertices and triangles in parry's types (`glam::DVec3`).
     pub fn to_parry(&self) -> (Vec<parry3d_f64::math::Vector>, Vec<[u32; 3]>) {
         (
-            self.vertices.iter().map(|p| to_dvec(p)).collect(),
+            self.vertices.iter().map(to_dvec).collect(),
             self.triangles.clone(),
         )
     }

@@ -126,7 +126,7 @@ pub fn validate(a: &Assembly, opts: &ValidateOptions) -> Result<Validation> {
     let mut pairs = Vec::new();
     for (k, c) in collision.iter().enumerate() {
         let (na, nb) = (&a.bodies[c.a].name, &a.bodies[c.b].name);
-        let v = visual.as_ref().map(|v| v[k].metrics.clone());
+        let v = visual.as_ref().map(|v| v[k].metrics);
         if let Some(v) = &v {
             let depth = v.max_penetration_depth;
             checks.push(Check {
@@ -161,7 +161,7 @@ pub fn validate(a: &Assembly, opts: &ValidateOptions) -> Result<Validation> {
             a: na.clone(),
             b: nb.clone(),
             visual: v,
-            collision: c.metrics.clone(),
+            collision: c.metrics,
         });
     }
     // Dynamics.

@@ -37,8 +37,10 @@ mod tests {
 
     #[test]
     fn gain_does_not_change_normalised_colours() {
-        let mut a = Cloud::default();
-        a.colours = vec![[0.2, 0.4, 0.1], [0.6, 0.2, 0.3], [0.1, 0.1, 0.9]];
+        let mut a = Cloud {
+            colours: vec![[0.2, 0.4, 0.1], [0.6, 0.2, 0.3], [0.1, 0.1, 0.9]],
+            ..Cloud::default()
+        };
         let mut b = a.clone();
         for c in &mut b.colours {
             c[0] *= 0.8;

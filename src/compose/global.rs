@@ -149,7 +149,7 @@ impl GlobalRegistration for FpfhRansac {
             }
             found.push((inliers, t));
         }
-        found.sort_by(|a, b| b.0.cmp(&a.0));
+        found.sort_by_key(|f| std::cmp::Reverse(f.0));
         let mut out: Vec<Similarity> = Vec::new();
         for (_, t) in found {
             if out.len() >= self.keep {

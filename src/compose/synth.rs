@@ -272,7 +272,7 @@ pub fn make(objects: &[TruthObject], seed: u64, o: &SynthOptions) -> Synthetic {
                     continue;
                 }
                 if let Some((_, d2)) = tr.nearest(p) {
-                    if contact.map_or(true, |c| d2 < c.0) {
+                    if contact.is_none_or(|c| d2 < c.0) {
                         contact = Some((d2, *p));
                     }
                 }

@@ -1465,14 +1465,14 @@ fn split_ways(
             let hi = x.iter().copied().fold(f64::NEG_INFINITY, f64::max);
             for frac in PLANE_FRACTIONS {
                 let c = lo + frac * (hi - lo);
-                let (a, b): (Vec<(u32, f64)>, Vec<(u32, f64)>) = part
-                    .tris
-                    .iter()
-                    .copied()
-                    .zip(x.iter().copied())
-                    .partition(|e| e.1 < c);
-                let a: Vec<u32> = a.into_iter().map(|e| e.0).collect();
-                let b: Vec<u32> = b.into_iter().map(|e| e.0).collect();
+                let (mut a, mut b) = (Vec::new(), Vec::new());
+                for (&t, &v) in part.tris.iter().zip(&x) {
+                    if v < c {
+                        a.push(t);
+                    } else {
+                        b.push(t);
+                    }
+                }
                 if !a.is_empty() && !b.is_empty() && !cands.iter().any(|c| c.0 == a) {
                     cands.push((a, b));
                 }

@@ -372,6 +372,7 @@ fn check_accessor(acc: &gltf::Accessor, buffers: &[Vec<u8>]) -> std::result::Res
     Ok(())
 }
 
+#[allow(clippy::too_many_arguments)]
 fn read_primitive(
     path: &Path,
     root: &Path,

@@ -80,7 +80,7 @@ pub fn load_bytes(path: &Path, bytes: &[u8], root: &Path, limits: &Limits) -> Re
         mats.push(Material {
             name: m.name.clone(),
             // A texture in MTL multiplies with Kd; most exporters write Kd 1 with a texture.
-            base_color: [kd[0] as f64, kd[1] as f64, kd[2] as f64, alpha as f64],
+            base_color: [kd[0], kd[1], kd[2], alpha],
             texture,
         });
     }
@@ -94,7 +94,7 @@ pub fn load_bytes(path: &Path, bytes: &[u8], root: &Path, limits: &Limits) -> Re
         let positions: Vec<P3> = m
             .positions
             .chunks_exact(3)
-            .map(|c| P3::new(c[0] as f64, c[1] as f64, c[2] as f64))
+            .map(|c| P3::new(c[0], c[1], c[2]))
             .collect();
         let triangles: Vec<[u32; 3]> = m
             .indices
@@ -110,7 +110,7 @@ pub fn load_bytes(path: &Path, bytes: &[u8], root: &Path, limits: &Limits) -> Re
             Some(
                 m.texcoords
                     .chunks_exact(2)
-                    .map(|c| [c[0] as f64, 1.0 - c[1] as f64])
+                    .map(|c| [c[0], 1.0 - c[1]])
                     .collect(),
             )
         } else {

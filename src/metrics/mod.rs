@@ -90,6 +90,8 @@ pub enum Solid<'a> {
     Hulls(&'a [Mesh]),
 }
 
+// One per object, built once and never moved in a loop: boxing the mesh would buy nothing.
+#[allow(clippy::large_enum_variant)]
 enum Shape {
     Mesh(RayMesh),
     Hulls(Vec<Hull>),
@@ -334,7 +336,7 @@ impl Default for MetricsOptions {
     fn default() -> Self {
         MetricsOptions {
             points: 1_000_000,
-            seed: 0x1A7E_3D,
+            seed: 0x001A_7E3D,
             points_per_column: 8,
             depth_spacing: None,
         }
@@ -478,6 +480,7 @@ fn column_seed(seed: u64, axis: usize, c: usize) -> u64 {
     r.next_u64()
 }
 
+#[allow(clippy::too_many_arguments)]
 fn count_columns(
     a: &Prepared,
     b: &Prepared,

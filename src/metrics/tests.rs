@@ -459,7 +459,7 @@ fn deterministic_across_runs_and_thread_counts() {
     assert_ne!(other[0].metrics.inside_both, r1[0].metrics.inside_both);
     assert!((other[0].metrics.r_volume - r1[0].metrics.r_volume).abs() < 0.02);
     // Field names of the serialised result.
-    let j = serde_json::to_value(&r1[0]).unwrap();
+    let j = serde_json::to_value(r1[0]).unwrap();
     for k in [
         "a",
         "b",

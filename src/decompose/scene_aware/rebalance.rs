@@ -44,7 +44,7 @@ pub(super) fn rebalance(
     f: &Features,
     p: &Params,
     opts: &DecomposeOptions,
-    parts: &mut Vec<Part>,
+    parts: &mut [Part],
     rounds: usize,
     near: &[f64],
 ) -> usize {
