@@ -57,6 +57,20 @@ fn check_engines(scene: &Path, extra: &[&str]) {
             b["mass"]
         );
         assert!(rel(mj["objects"][name]["mass"].as_f64().unwrap(), mass) < 1e-6);
+        // Sliding and torsional friction (README, Contacts): with condim 3 MuJoCo ignores the
+        // torsional coefficient the geoms carry, and a leaning item spins on its contact.
+        if o["hull_count"].as_u64().unwrap() > 0 {
+            for condim in [
+                &b["collision_condim"],
+                &mj["objects"][name]["collision_condim"],
+            ] {
+                assert_eq!(
+                    condim,
+                    &serde_json::json!([4]),
+                    "{name}: collision geoms' condim"
+                );
+            }
+        }
         let mut principal: Vec<f64> = b["inertia_principal"]
             .as_array()
             .unwrap()

@@ -2,7 +2,8 @@
 
 usage: check_mujoco.py OUT_DIR [--seconds S] [--key NAME]
 
-Reports: body and geom counts per body, masses and inertias as MuJoCo compiled them, the deepest
+Reports: body and geom counts per body, the contact dimensionality of the collision geoms (condim),
+masses and inertias as MuJoCo compiled them, the deepest
 initial contact between different bodies, per-body motion after S seconds (position change in m,
 rotation angle in degrees) and final body positions, whether the state stayed finite, and which free bodies moved more
 than 1 mm / 1 degree. Also loads every <object>.xml alone and all of them through <include>.
@@ -48,6 +49,7 @@ def main():
             "inertia_principal": [float(x) for x in model.body_inertia[b]],
             "visual_geoms": sum(1 for g in geoms if model.geom_group[g] == 2),
             "collision_geoms": sum(1 for g in geoms if model.geom_group[g] == 3),
+            "collision_condim": sorted({int(model.geom_condim[g]) for g in geoms if model.geom_group[g] == 3}),
             "free": bool(model.body_jntnum[b] > 0),
         }
 
@@ -87,7 +89,11 @@ def main():
     for name in bodies:
         path = os.path.join(out, name + ".xml")
         m = mujoco.MjModel.from_xml_path(path)
-        objects_ok[name] = {"nbody": int(m.nbody), "mass": float(m.body_mass[1])}
+        objects_ok[name] = {
+            "nbody": int(m.nbody),
+            "mass": float(m.body_mass[1]),
+            "collision_condim": sorted({int(m.geom_condim[g]) for g in range(m.ngeom) if m.geom_group[g] == 3}),
+        }
         includes.append('<include file="%s.xml"/>' % name)
     with tempfile.NamedTemporaryFile("w", suffix=".xml", dir=out, delete=False) as f:
         f.write('<mujoco model="includes">%s</mujoco>' % "".join(includes))
