@@ -76,6 +76,10 @@ mod tests;
 use crate::mesh::{Mesh, P3};
 use crate::rng::Rng;
 use bvh::{Bb, Bvh};
+/// Squared distance between two closed triangles (0 when they intersect): vertex–triangle and
+/// edge–edge distances after an intersection test. `examples/make_fixtures.rs` checks the
+/// fixtures' gaps with it.
+pub use geom::tri_tri_dist2;
 use geom::V;
 use inside::{Hull, RayMesh};
 use rayon::prelude::*;
