@@ -30,12 +30,12 @@ const R: f64 = 0.08;
 const H: f64 = 0.055;
 const WALL: f64 = 0.004;
 
-/// Samples along the inner wall's quarter ellipse: (√K, area) of each band.
+/// Samples along the inner wall's quarter ellipse: (√K, area) of each band, largest √K first.
 fn inner_wall(steps: usize) -> Vec<(f64, f64)> {
     // Inner wall: ρ = R/2 + a·sin θ, z = H − c·cos θ, θ ∈ [0, π/2] (see `shapes::bowl_profile`).
     let (rf, a, c) = (R / 2.0, R / 2.0 - WALL, H - WALL);
     let dth = PI / 2.0 / steps as f64;
-    (0..steps)
+    let mut wall: Vec<(f64, f64)> = (0..steps)
         .map(|i| {
             let th = (i as f64 + 0.5) * dth;
             let rho = rf + a * th.sin();
@@ -46,17 +46,17 @@ fn inner_wall(steps: usize) -> Vec<(f64, f64)> {
             let k_hoop = z1 / (rho * speed);
             ((k_meridian * k_hoop).sqrt(), 2.0 * PI * rho * speed * dth)
         })
-        .collect()
+        .collect();
+    wall.sort_by(|x, y| y.0.total_cmp(&x.0));
+    wall
 }
 
-/// Patches needed to keep the wall within `t` (m), tiling factor `c`, leaving out the area
-/// `give_up` where √K is largest.
+/// Patches needed to keep the wall (from [`inner_wall`]) within `t` (m), tiling factor `c`,
+/// leaving out the area `give_up` where √K is largest.
 fn patches(wall: &[(f64, f64)], t: f64, c: f64, give_up: f64) -> f64 {
-    let mut by_k = wall.to_vec();
-    by_k.sort_by(|x, y| y.0.total_cmp(&x.0));
     let mut left = give_up;
     let mut integral = 0.0;
-    for (k, a) in by_k {
+    for &(k, a) in wall {
         let skip = left.min(a);
         left -= skip;
         integral += k * (a - skip);
@@ -104,14 +104,15 @@ fn main() {
     let diag = surface.diag;
     let wall = inner_wall(20_000);
     let wall_area: f64 = wall.iter().map(|w| w.1).sum();
-    let give_up = 0.05 * mesh.area();
+    let area = mesh.area();
+    let give_up = 0.05 * area;
     let integral: f64 = wall.iter().map(|w| w.0 * w.1).sum();
     // The ellipse around a regular hexagon, per unit of the hexagon's area.
     let hex = 2.0 * PI / (3.0 * 3f64.sqrt());
     println!(
         "bowl fixture: diagonal {:.1} mm, surface {:.1} cm², inner wall {:.1} cm² (∫√K dA = {:.3}; a hemisphere's is 2π)",
         diag * 1e3,
-        mesh.area() * 1e4,
+        area * 1e4,
         wall_area * 1e4,
         integral
     );

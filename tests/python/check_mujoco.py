@@ -3,10 +3,9 @@
 usage: check_mujoco.py OUT_DIR [--seconds S] [--key NAME]
 
 Reports: body and geom counts per body, the contact dimensionality of the collision geoms (condim),
-masses and inertias as MuJoCo compiled them, the deepest
-initial contact between different bodies, per-body motion after S seconds (position change in m,
-rotation angle in degrees) and final body positions, whether the state stayed finite, and which free bodies moved more
-than 1 mm / 1 degree. Also loads every <object>.xml alone and all of them through <include>.
+masses and inertias as MuJoCo compiled them, the deepest initial contact between different bodies,
+per-body motion after S seconds (position change in m, rotation angle in degrees) and final body
+positions, whether the state stayed finite, and which free bodies moved more than 1 mm / 1 degree. Also loads every <object>.xml alone and all of them through <include>.
 """
 import json
 import math

@@ -1055,21 +1055,20 @@ fn only_neighbours_above_a_triangle_may_rest_on_it() {
 fn a_patch_is_pinned_by_touched_walls_and_floors_in_reach_only() {
     let o = opts();
     let (r, gap) = (0.03, 5e-5);
-    let at = |m: Mesh, d: V3| moved(&m, d);
-    let ball = Surface::new(&at(
-        shapes::uv_sphere(r, 64, 128),
+    let ball = Surface::new(&moved(
+        &shapes::uv_sphere(r, 64, 128),
         V3::new(0.0, 0.0, r + gap),
     ))
     .unwrap();
-    let slab = at(
-        shapes::cuboid(V3::new(1.0, 1.0, 0.01)),
+    let slab = moved(
+        &shapes::cuboid(V3::new(1.0, 1.0, 0.01)),
         V3::new(0.0, 0.0, -0.005),
     );
     let slab = Surface::new(&slab).unwrap();
     // A 10 mm wall whose face is at x.
     let wall_at = |x: f64| {
-        let m = at(
-            shapes::cuboid(V3::new(0.01, 0.2, 0.2)),
+        let m = moved(
+            &shapes::cuboid(V3::new(0.01, 0.2, 0.2)),
             V3::new(x + 0.005, 0.0, 0.1),
         );
         Surface::new(&m).unwrap()
@@ -1109,8 +1108,8 @@ fn a_patch_is_pinned_by_touched_walls_and_floors_in_reach_only() {
         assert!(gap <= circumradius(&ball, t) + o.clearance, "{t}: {gap}");
     }
     let (rc, h) = (0.02, 0.04);
-    let cyl = at(
-        shapes::cylinder(rc, h, 64),
+    let cyl = moved(
+        &shapes::cylinder(rc, h, 64),
         V3::new(0.0, 0.0, h / 2.0 + gap),
     );
     let cyl = Surface::new(&cyl).unwrap();
@@ -1146,14 +1145,13 @@ fn a_floor_pins_under_a_neighbour_not_beside_one() {
     profile.extend((1..20).map(|k| [rp - 0.005 * k as f64, top]));
     let puck = Surface::new(&shapes::revolve(&profile, 128)).unwrap();
     let p = Params::new(&puck, &o, Strategy::Patches);
-    let at = |m: Mesh, d: V3| moved(&m, d);
-    let wall = at(
-        shapes::cuboid(V3::new(0.01, 0.2, 0.2)),
+    let wall = moved(
+        &shapes::cuboid(V3::new(0.01, 0.2, 0.2)),
         V3::new(rp + gap + 0.005, 0.0, 0.1),
     );
     let wall = Surface::new(&wall).unwrap();
-    let cube = at(
-        shapes::cuboid(V3::new(0.03, 0.03, 0.03)),
+    let cube = moved(
+        &shapes::cuboid(V3::new(0.03, 0.03, 0.03)),
         V3::new(0.0, 0.0, top + gap + 0.015),
     );
     let cube = Surface::new(&cube).unwrap();
