@@ -31,7 +31,9 @@ pub struct PreparedObject {
     /// Mesh frame → world.
     pub to_world: Similarity,
     pub physical: Physical,
-    /// The geometry is watertight and consistently oriented.
+    /// The geometry bounds a solid: watertight and consistently oriented, though more than two
+    /// triangles may meet on an edge ([`Mesh::bounds_solid`]); its mass properties are then
+    /// exact.
     pub closed: bool,
     pub warnings: Vec<String>,
 }
@@ -112,10 +114,10 @@ pub fn prepare(scene: &Scene, opts: &PrepareOptions) -> Result<PreparedScene> {
         let mut visual = o.visual.clone();
         visual.transform(&to_world.matrix());
         let geometry = visual.geometry();
-        let closed = geometry.is_closed();
+        let closed = geometry.bounds_solid();
         let mut w = Vec::new();
         if !closed {
-            w.push("mesh is not closed (open or non-manifold): inertia falls back to the union of the collision hulls".to_string());
+            w.push("mesh is not closed (a hole, a fin or a flipped triangle): inertia falls back to the union of the collision hulls".to_string());
         }
         objects.push(PreparedObject {
             name: o.name.clone(),

@@ -720,6 +720,32 @@ pub fn stripes_texture(size: u32, stripes: u32, a: [u8; 3], b: [u8; 3], origin: 
     png_texture(&img, origin)
 }
 
+/// Two cubes of side `a`, the first centred on the origin, the second on `(a, a, 0)`: they meet
+/// along the edge `x = y = a/2`, whose two vertices they share. Four triangles meet on that
+/// edge, as on the few non-manifold edges of scans (see [`Mesh::bounds_solid`]).
+pub fn cubes_on_an_edge(a: f64) -> Mesh {
+    let c = cuboid(V3::new(a, a, a));
+    let mut vertices = c.vertices.clone();
+    let shift = V3::new(a, a, 0.0);
+    let index: Vec<u32> = c
+        .vertices
+        .iter()
+        .map(|v| {
+            let w = v + shift;
+            match vertices.iter().position(|u| (u - w).norm() < 1e-12 * a) {
+                Some(i) => i as u32,
+                None => {
+                    vertices.push(w);
+                    vertices.len() as u32 - 1
+                }
+            }
+        })
+        .collect();
+    let mut triangles = c.triangles.clone();
+    triangles.extend(c.triangles.iter().map(|t| t.map(|i| index[i as usize])));
+    Mesh::new(vertices, triangles)
+}
+
 /// A material showing `texture` unmodified (base colour factor white).
 pub fn textured_material(name: &str, texture: Texture) -> Material {
     Material {
@@ -750,6 +776,30 @@ mod tests {
         // Put back twice: its 3 edges run twice the same way, and no hole.
         m.triangles.extend([t, t]);
         assert_eq!(m.edge_defects(), (3, 0));
+    }
+
+    /// Two cubes meeting along an edge, welded there: four triangles meet on it, each of its
+    /// directed edges is run twice. Not [`Mesh::is_closed`], but it bounds a solid whose
+    /// signed volume is the two cubes'. A hole, a fin on an edge or a flipped triangle does not.
+    #[test]
+    fn two_cubes_on_a_shared_edge_bound_a_solid() {
+        let m = cubes_on_an_edge(1.0);
+        assert_eq!(m.edge_defects(), (2, 0));
+        assert!(!m.is_closed() && m.bounds_solid());
+        assert!((m.signed_volume() - 2.0).abs() < 1e-12);
+        let mut hole = m.clone();
+        hole.triangles.pop();
+        assert!(!hole.bounds_solid());
+        let mut flipped = m.clone();
+        flipped.triangles[3].swap(0, 1);
+        assert!(!flipped.bounds_solid());
+        let mut fin = m.clone();
+        let [a, b, _] = fin.triangles[0];
+        fin.vertices.push(P3::new(3.0, 3.0, 3.0));
+        fin.triangles.push([a, b, fin.vertices.len() as u32 - 1]);
+        assert!(!fin.bounds_solid());
+        assert!(cuboid(V3::new(1.0, 2.0, 3.0)).bounds_solid());
+        assert!(!Mesh::new(Vec::new(), Vec::new()).bounds_solid());
     }
 
     #[test]
