@@ -218,6 +218,19 @@ fn main() {
             "ycb/005_tomato_soup_can/textured.obj",
             "ycb/019_pitcher_base/textured.obj",
             "gso/Threshold_Porcelain_Teapot_White/model.obj",
+            // The other shared objects our engine leaves above the tolerance alone, and the
+            // containers and supports among them.
+            "gso/ACE_Coffee_Mug_Kristen_16_oz_cup/model.obj",
+            "gso/Cole_Hardware_Mug_Classic_Blue/model.obj",
+            "gso/Threshold_Porcelain_Coffee_Mug_All_Over_Bead_White/model.obj",
+            "gso/Threshold_Porcelain_Pitcher_White/model.obj",
+            "ycb/065-a_cups/textured.obj",
+            "ycb/029_plate/textured.obj",
+            "gso/Chelsea_lo_fl_rdheel_zAQrnhlEfw8/model.obj",
+            "gso/Reebok_ZIGLITE_RUSH/model.obj",
+            "gso/TROCHILUS_BOOST/model.obj",
+            "ycb/037_scissors/textured.obj",
+            "ycb/073-a_lego_duplo/textured.obj",
         ] {
             match scan(rel, 1.0) {
                 Some(s) => scenes.push(s),
