@@ -29,11 +29,11 @@
 //!    can's rim above its recessed lid, a pitcher's handle: `star_with_patches`). The closer
 //!    of these is kept when within the tolerance at the 95th percentile, else when closer
 //!    than step 2's patches, whose chords would leave a shell with the inside hollow (YCB
-//!    apple: 24 % of its volume, p95 3.5 %), and never when a hull reaches farther past the surface than
-//!    5 tolerances or the patches' own farthest, or lifts what a neighbour may stand on
-//!    (`keeps_support`). A solid whose star pieces would lift it gets them under *slabs*
-//!    instead: one-sided patches where the neighbour stands, the pieces' rays stopped below
-//!    them (`star_on_slabs`; the `00009` lunch box, p95 3.93 → 0.81 %).
+//!    apple: 24 % of its volume, p95 3.5 %), and never when a hull reaches farther past the
+//!    surface than 5 tolerances or the patches' own farthest, or lifts what a neighbour may
+//!    stand on (`keeps_support`). A solid whose star pieces would lift it gets them under
+//!    *slabs* instead: one-sided patches where the neighbour stands, the pieces' rays stopped
+//!    below them (`star_on_slabs`; the `00009` lunch box, p95 3.93 → 0.81 %).
 //! 2. **Wall-segment / surface-patch hulls** otherwise. Change from the suggested design: a
 //!    pure surface patch on a thin wall bulges *through* the wall into the cavity (its chord),
 //!    and covering the outer and inner sides separately halves the budget per side. So each
@@ -1177,7 +1177,7 @@ impl Solid {
     ) -> Obj {
         // Surface patches among the parts (the slabs, or the patches over what the centre
         // does not see): the contact refinement may split them.
-        let patches = parts.iter().filter(|q| !q.tris.is_empty()).count();
+        let surface_patches = parts.iter().filter(|q| !q.tris.is_empty()).count();
         let with_patches = matches!(self, Solid::StarOnSlabs | Solid::StarWithPatches);
         Obj {
             parts,
@@ -1187,12 +1187,12 @@ impl Solid {
             report: ObjectReport {
                 star_pieces: self != Solid::Voxel,
                 slabs: if self == Solid::StarOnSlabs {
-                    patches
+                    surface_patches
                 } else {
                     0
                 },
                 unseen_patches: if self == Solid::StarWithPatches {
-                    patches
+                    surface_patches
                 } else {
                     0
                 },
