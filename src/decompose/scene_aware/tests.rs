@@ -1005,6 +1005,23 @@ fn star_pieces_reach_a_cap_poking_out_of_a_solid() {
     );
 }
 
+/// What a point sees of a cube: from its centre, all of it; from a point on the x axis outside
+/// it, only the face towards the point, so 5/6 of the (area-sampled) surface lies behind the
+/// near face, and the far face, a cube's width behind it, is 1/6 (sampling: 2,000 points,
+/// standard error 0.008).
+#[test]
+fn hidden_is_the_share_of_the_surface_behind_the_surface() {
+    let cube = shapes::cuboid(V3::new(1.0, 1.0, 1.0));
+    let s = Surface::new(&cube).unwrap();
+    let probes = s.samples(2000, 7);
+    assert_eq!(hidden(&s, &P3::origin(), &probes, 1e-6), 0.0);
+    let out = P3::new(3.0, 0.0, 0.0);
+    let h = hidden(&s, &out, &probes, 1e-6);
+    assert!((h - 5.0 / 6.0).abs() < 0.03, "{h}");
+    let h = hidden(&s, &out, &probes, 0.999);
+    assert!((h - 1.0 / 6.0).abs() < 0.03, "{h}");
+}
+
 /// A can, as the YCB soup can is built: a cylinder (radius 33 mm, 100 mm tall) whose lid is
 /// recessed 6 mm inside a 2 mm rim. Rays from its centre meet the lid before the rim, which
 /// stands in their shadow, so the star pieces fail their reach test, and surface patches
