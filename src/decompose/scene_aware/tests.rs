@@ -33,6 +33,14 @@ fn shared() -> Option<PathBuf> {
         .find(|p| p.join("datasets/scenes").is_dir())
 }
 
+/// The geometry of a shared object, `rel` under `shared/datasets/objects`.
+fn shared_object(sh: &Path, rel: &str) -> Mesh {
+    let p = sh.join("datasets/objects").join(rel);
+    crate::io::load_visual(&p, &crate::io::Limits::default())
+        .unwrap()
+        .geometry()
+}
+
 fn world_meshes(path: &Path) -> Vec<Mesh> {
     let scene = crate::scene::load(path, &crate::io::Limits::default()).expect("scene loads");
     let prep = crate::prepare::prepare(&scene, &Default::default()).expect("scene prepares");
@@ -1291,12 +1299,7 @@ fn real_solids_are_filled_star_pieces_for_an_apple_and_a_pear_voxels_for_a_banan
         return;
     };
     let o = opts();
-    let load = |rel: &str| {
-        let p = sh.join("datasets/objects/ycb").join(rel);
-        crate::io::load_visual(&p, &crate::io::Limits::default())
-            .unwrap()
-            .geometry()
-    };
+    let load = |rel: &str| shared_object(&sh, &format!("ycb/{rel}"));
     let apple = load("013_apple/textured.obj");
     let (hulls, rep) = decompose_scene(&[&apple], &o);
     assert!(rep.objects[0].star_pieces);
@@ -1346,10 +1349,7 @@ fn real_solids_the_centre_does_not_see_whole_get_star_pieces_with_patches() {
         "ycb/019_pitcher_base/textured.obj",
         "gso/Threshold_Porcelain_Teapot_White/model.obj",
     ] {
-        let p = sh.join("datasets/objects").join(rel);
-        let mesh = crate::io::load_visual(&p, &crate::io::Limits::default())
-            .unwrap()
-            .geometry();
+        let mesh = shared_object(&sh, rel);
         let (hulls, rep) = decompose_scene(&[&mesh], &o);
         let r = &rep.objects[0];
         assert!(r.star_pieces && r.unseen_patches > 0, "{rel}: {r:?}");
