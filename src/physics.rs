@@ -111,7 +111,11 @@ pub struct SettleOptions {
     /// Settle fails when the centre of mass moves more than this fraction of the body's
     /// bounding-box diagonal.
     pub max_relative_drift: f64,
-    /// Settle fails when the body turns more than this (degrees).
+    /// Settle fails when the body turns more than this (degrees) and the turn moved its shape:
+    /// some hull vertex, turned about the centre of mass, lies farther than
+    /// `max_relative_drift` of the bounding-box diagonal from the unturned hulls (or the other
+    /// way). A turn about an axis the body is nearly symmetric around (a pen rolling about its
+    /// own axis, a ball) leaves the space it takes where it was and is only noted.
     pub max_settle_rotation_deg: f64,
     /// Rest fails when the centre of mass moves more than this (m) at any time of the rest phase.
     pub max_rest_motion: f64,
@@ -207,6 +211,11 @@ pub struct BodyReport {
     pub settle_displacement: f64,
     /// Rotation angle from the composed pose to the settled pose (degrees).
     pub settle_rotation_deg: f64,
+    /// When `settle_rotation_deg` exceeds the limit: how far that turn alone, about the centre
+    /// of mass, moved the body's shape (m), the largest distance from a turned hull vertex to
+    /// the unturned hulls or from an unturned vertex to the turned hulls. Small for a turn
+    /// about an axis of near symmetry. `None` when the rotation is within the limit.
+    pub settle_shape_shift: Option<f64>,
     /// `settle_displacement / bbox_diagonal`.
     pub relative_drift: f64,
     /// Largest centre-of-mass displacement from the settled pose during the rest phase (m).
@@ -356,6 +365,8 @@ pub fn settle(bodies: &[SimBody], opts: &SettleOptions) -> Result<SettleReport, 
         let diag = sim.bbox_diagonal[i];
         let (disp, rot) = drift(&composed[i], &settled[i], &b.com);
         let rel = if diag > 0.0 { disp / diag } else { 0.0 };
+        let shape_shift = (!b.fixed && rot > opts.max_settle_rotation_deg)
+            .then(|| sim.shape_shift(i, &composed[i], &settled[i]));
         let supports: Vec<usize> = start.supports[i].clone();
         let touching: Vec<usize> = after.touching[i].clone();
         let body_supports: Vec<usize> = supports.iter().copied().filter(|&k| k != n).collect();
@@ -393,11 +404,26 @@ pub fn settle(bodies: &[SimBody], opts: &SettleOptions) -> Result<SettleReport, 
                     opts.max_relative_drift * 100.0
                 ));
             }
-            if rot > opts.max_settle_rotation_deg {
-                reasons.push(format!(
+            if let Some(shift) = shape_shift {
+                let what = format!(
                     "turned {:.1}° while settling (> {:.1}°)",
                     rot, opts.max_settle_rotation_deg
-                ));
+                );
+                let by = format!(
+                    "the turn moved its shape by {:.1} mm ({:.1}% of its diagonal",
+                    mm(shift),
+                    100.0 * shift / diag
+                );
+                if shift > opts.max_relative_drift * diag {
+                    reasons.push(format!(
+                        "{what}: {by} > {:.1}%)",
+                        opts.max_relative_drift * 100.0
+                    ));
+                } else {
+                    notes.push(format!(
+                        "{what} about an axis it is nearly symmetric around: {by}), not counted"
+                    ));
+                }
             }
             if left {
                 reasons.push(format!(
@@ -449,6 +475,7 @@ pub fn settle(bodies: &[SimBody], opts: &SettleOptions) -> Result<SettleReport, 
             bbox_diagonal: diag,
             settle_displacement: disp,
             settle_rotation_deg: rot,
+            settle_shape_shift: shape_shift,
             relative_drift: rel,
             rest_displacement: rest_disp[i],
             rest_rotation_deg: rest_rot[i],
@@ -790,6 +817,34 @@ impl<'a> Sim<'a> {
                     .collect()
             })
             .collect()
+    }
+
+    /// How far the turn from pose `a` to pose `b` moves body `i`'s shape, the translation
+    /// left out (see [`BodyReport::settle_shape_shift`]). Hull vertices sample the shape: the
+    /// distance to a convex hull is convex, so over each turned hull it peaks at a vertex.
+    fn shape_shift(&self, i: usize, a: &Isometry3<f64>, b: &Isometry3<f64>) -> f64 {
+        let body = &self.bodies[i];
+        let shapes: Vec<&dyn Shape> = self.colliders[i]
+            .iter()
+            .map(|&c| self.world.colliders[c].shape())
+            .collect();
+        // The turn in the body frame: body point p at pose b sits where com + turn·(p − com)
+        // sits at pose a, once the centres of mass are matched.
+        let turn = a.rotation.inverse() * b.rotation;
+        let gap = |turn: &UnitQuaternion<f64>| -> f64 {
+            body.hulls
+                .iter()
+                .flat_map(|h| h.vertices.iter())
+                .map(|p| {
+                    let q = body.com + turn * (p - body.com);
+                    shapes
+                        .iter()
+                        .map(|s| s.distance_to_local_point(Vector::new(q.x, q.y, q.z), true))
+                        .fold(f64::INFINITY, f64::min)
+                })
+                .fold(0.0, f64::max)
+        };
+        gap(&turn).max(gap(&turn.inverse()))
     }
 
     /// Signed distance of a body's lowest hull vertex to the floor plane.

@@ -175,7 +175,8 @@ pub fn validate(a: &Assembly, opts: &ValidateOptions) -> Result<Validation> {
             continue;
         }
         let settle_ok = b.relative_drift <= s.max_relative_drift
-            && b.settle_rotation_deg <= s.max_settle_rotation_deg
+            && b.settle_shape_shift
+                .is_none_or(|shift| shift <= s.max_relative_drift * b.bbox_diagonal)
             && !b.left_supports
             && !b.ended_on_floor;
         let settle_reasons: Vec<&String> = b

@@ -15,14 +15,21 @@ struct Outcome {
 }
 
 fn export_validated(scene: &Path) -> Outcome {
+    export_validated_with(scene, &[])
+}
+
+/// [`export_validated`] with more `export` arguments.
+fn export_validated_with(scene: &Path, args: &[&str]) -> Outcome {
     let out = tempfile::tempdir().unwrap();
     let dir = out.path().join("out");
-    let (code, _, err) = run(&[
+    let mut all = vec![
         "export",
         scene.to_str().unwrap(),
         "-o",
         dir.to_str().unwrap(),
-    ]);
+    ];
+    all.extend_from_slice(args);
+    let (code, _, err) = run(&all);
     assert!(code == 0 || code == 1, "export {}: {err}", scene.display());
     let report = read_json(&dir.join("report.json"));
     assert_eq!(
@@ -209,6 +216,35 @@ fn unstable_fixture_fails_by_toppling() {
     let b = &o.report["validation"]["settle"]["bodies"][0];
     assert!(b["settle_rotation_deg"].as_f64().unwrap() > 30.0, "{b}");
     assert_eq!(b["passed"], false);
+}
+
+/// At 64 hulls Rapier rolls the pen of the pen-in-mug fixture 30.3° about its own axis while it
+/// settles against the rim, past the 30° limit. That turn leaves the pen's shape where it was
+/// (a 16-sided prism: within 0.3 mm), so it is noted, not failed; MuJoCo keeps the pen there.
+#[test]
+fn pen_rolling_about_its_own_axis_in_the_mug_passes() {
+    let o = export_validated_with(&root().join("fixtures/pen_mug"), &["--max-hulls", "64"]);
+    assert_eq!(o.code, 0, "{}", o.report["validation"]["checks"]);
+    let pen = &o.report["validation"]["settle"]["bodies"][1];
+    assert_eq!(pen["name"], "object_b");
+    if pen["settle_rotation_deg"].as_f64().unwrap() > 30.0 {
+        let shift = pen["settle_shape_shift"].as_f64().unwrap();
+        assert!(shift < 0.3 * MM, "{pen}");
+        let notes = pen["notes"].as_array().unwrap();
+        assert!(notes
+            .iter()
+            .any(|n| n.as_str().unwrap().contains("not counted")));
+    }
+    let dir = o.out.path().join("out");
+    let mj = python_json(
+        "check_mujoco.py",
+        &[dir.to_str().unwrap(), "--seconds", "2"],
+    );
+    assert!(
+        moved_beyond(&mj["motion"], 2.0 * MM, 5.0).is_empty(),
+        "MuJoCo: {}",
+        mj["motion"]
+    );
 }
 
 #[test]

@@ -4,7 +4,7 @@ use super::*;
 use crate::mesh::V3;
 use crate::shapes::{cuboid, uv_sphere};
 use nalgebra::{Matrix4, Vector3};
-use std::f64::consts::{FRAC_PI_4, PI};
+use std::f64::consts::{FRAC_1_SQRT_2, FRAC_PI_4, PI};
 
 fn at(x: f64, y: f64, z: f64) -> Isometry3<f64> {
     Isometry3::translation(x, y, z)
@@ -136,6 +136,54 @@ fn box_on_its_edge_topples() {
         "{:?}",
         b.reasons
     );
+    // Onto a face: a quarter of the cube's own symmetry turn. Its corners then stand out of the
+    // unturned cube by s (1/√2 − 1/2), 12 % of the diagonal.
+    let shift = b.settle_shape_shift.expect("measured past the limit");
+    assert!((b.settle_rotation_deg - 45.0).abs() < 1.0);
+    let expected = s * (FRAC_1_SQRT_2 - 0.5);
+    assert!(
+        (shift - expected).abs() < 0.01 * expected,
+        "{shift} vs {expected}"
+    );
+    assert!(shift > 0.1 * b.bbox_diagonal, "{shift}");
+}
+
+/// `Sim::shape_shift` of a 16-sided prism (a pen: radius 5 mm, 140 mm long) turned by 40°.
+#[test]
+fn a_turn_about_an_axis_of_symmetry_barely_moves_the_shape() {
+    let (r, h, n) = (0.005, 0.14, 16);
+    let pen = SimBody {
+        name: "pen".into(),
+        pose: at(0.0, 0.0, 0.1),
+        hulls: vec![crate::shapes::cylinder(r, h, n)],
+        mass: 0.01,
+        com: P3::origin(),
+        inertia: Matrix3::identity() * 1e-6,
+        friction: 0.6,
+        fixed: false,
+    };
+    let opts = SettleOptions::default();
+    let sim = Sim::new(std::slice::from_ref(&pen), &opts).unwrap();
+    let turned = |axis: &nalgebra::Unit<Vector3<f64>>| {
+        Isometry3::from_parts(
+            pen.pose.translation,
+            UnitQuaternion::from_axis_angle(axis, 40f64.to_radians()),
+        )
+    };
+    // About its own axis: every rim vertex lands 17.5° past a vertex of the 22.5° polygon, out
+    // of the edge there (its normal 11.25° from the vertex, its line r cos 11.25° from the axis).
+    let half = PI / n as f64;
+    let expected = r * ((17.5f64.to_radians() - half).cos() - half.cos());
+    let spin = sim.shape_shift(0, &pen.pose, &turned(&Vector3::z_axis()));
+    assert!((spin - expected).abs() < 1e-9, "{spin} vs {expected}");
+    // About a transverse axis: the rim vertex at (0, −r, h/2) swings out to
+    // y = −(r cos 40° + h/2 sin 40°), that far minus r from the prism's side.
+    let (c, s) = (40f64.to_radians().cos(), 40f64.to_radians().sin());
+    let tilt = sim.shape_shift(0, &pen.pose, &turned(&Vector3::x_axis()));
+    let swing = r * c + h / 2.0 * s - r;
+    assert!((tilt - swing).abs() < 0.02 * swing, "{tilt} vs {swing}");
+    let diag = (8.0 * r * r + h * h).sqrt();
+    assert!(spin < 0.001 * diag && tilt > 0.25 * diag);
 }
 
 #[test]
