@@ -8,6 +8,8 @@
 //! 1. **Settle**: simulate from the composed pose until every dynamic body sleeps (capped). The
 //!    drift from the composed pose (centre-of-mass displacement, rotation angle) must stay small
 //!    relative to the object's size, and an object must still touch what it was resting in or on.
+//!    A large rotation counts only if it moved the object's shape, not a pen's roll about its
+//!    own axis (see [`SettleOptions::max_settle_rotation_deg`]).
 //! 2. **Rest**: from the settled state, with sleeping disabled so that creep cannot hide behind
 //!    the sleep heuristic, simulate some more: every object must stay put, and the contact
 //!    penetration, measured with exact f64 convex queries (not Rapier's possibly recycled contact

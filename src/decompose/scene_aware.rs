@@ -50,7 +50,7 @@
 //!    so cavities stay open, and it has at most `max_vertices` vertices. Quality loop: from
 //!    half the budget (at most 16 patches), the patch whose hull deviates most from the mesh
 //!    (max of sampled distances; for a wall segment, not those inside the material, which are
-//!    seams with the segments beside it: see [`deviation`]) is split while that exceeds the
+//!    seams with the segments beside it: see `deviation`) is split while that exceeds the
 //!    tolerance and the budget lasts; a split tries 2-means and area-median cuts across the
 //!    two PCA axes and keeps the one whose worse half deviates least. Objects with neighbours
 //!    keep `max_hulls/8` of the budget for step 3.

@@ -118,7 +118,7 @@ impl Surface {
     }
 
     /// Whether some point of the surface is within `r` of `p`: the triangles of `p`'s grid
-    /// cell (see [`Cells`]), then a depth-first descent of the BVH of `tri` that stops at the
+    /// cell (see `Cells`), then a depth-first descent of the BVH of `tri` that stops at the
     /// first triangle found, with squared distances to the triangles
     /// ([`point_triangle_dist2`]); a third of the cost of a [`Surface::distance`] when one is
     /// near. The cell answers most questions of the engine, which are about points near the
