@@ -1525,6 +1525,7 @@ fn split_ways(
     if part.tris.len() < 2 {
         return Vec::new();
     }
+    debug_assert!(part.tris.is_sorted(), "a patch's triangles are ascending");
     let mut cands: Vec<(Vec<u32>, Vec<u32>)> = Vec::new();
     let halves = patches::kmeans(s, f, &part.tris, 2, p.lambda, 12);
     if let [a, b] = &halves[..] {
@@ -1545,27 +1546,38 @@ fn split_ways(
         });
         for &k in &order[..2] {
             let axis = eig.eigenvectors.column(k).into_owned();
-            let mut by: Vec<(f64, u32)> = part
+            let by: Vec<(f64, u32)> = part
                 .tris
                 .iter()
                 .map(|&t| (axis.dot(&f.pos[t as usize].coords), t))
                 .collect();
-            by.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+            // Ordered along the axis, ties by triangle: every key differs, so an unstable
+            // sort orders them as a stable one would.
+            let mut sorted = by.clone();
+            let key = |a: &(f64, u32), b: &(f64, u32)| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1));
+            sorted.sort_unstable_by(key);
             let fracs: &[f64] = if fine { &PLANE_FRACTIONS } else { &[0.5] };
             for &frac in fracs {
                 let mut acc = 0.0;
-                let mut cut = by.len() / 2;
-                for (i, &(_, t)) in by.iter().enumerate() {
+                let mut cut = sorted.len() / 2;
+                for (i, &(_, t)) in sorted.iter().enumerate() {
                     acc += s.tri_area[t as usize];
                     if acc >= frac * w {
-                        cut = (i + 1).clamp(1, by.len() - 1);
+                        cut = (i + 1).clamp(1, sorted.len() - 1);
                         break;
                     }
                 }
-                let mut a: Vec<u32> = by[..cut].iter().map(|x| x.1).collect();
-                let mut b: Vec<u32> = by[cut..].iter().map(|x| x.1).collect();
-                a.sort_unstable();
-                b.sort_unstable();
+                // The halves in the patch's (ascending) order: those before the first of the
+                // second half along the axis, and the others.
+                let first = sorted[cut];
+                let (mut a, mut b) = (Vec::new(), Vec::new());
+                for x in &by {
+                    if key(x, &first).is_lt() {
+                        a.push(x.1);
+                    } else {
+                        b.push(x.1);
+                    }
+                }
                 cands.push((a, b));
             }
         }

@@ -7,16 +7,18 @@
 
 use super::geom::Surface;
 use crate::mesh::{P3, V3};
-use nalgebra::Matrix3;
 use rayon::prelude::*;
 
 /// Per-triangle clustering features.
 pub struct Features {
     /// Mid-wall position of each triangle.
     pub pos: Vec<P3>,
-    /// `n·nᵀ` of each triangle normal.
-    pub orient: Vec<Matrix3<f64>>,
+    /// `n·nᵀ` of each triangle normal, its upper triangle (see [`Sym`]).
+    pub orient: Vec<Sym>,
 }
+
+/// A symmetric 3×3 matrix by its upper triangle: `[m00, m01, m02, m11, m12, m22]`.
+pub type Sym = [f64; 6];
 
 impl Features {
     /// `merge_depth`: walls up to twice this thick are merged; thicker material keeps its sides
@@ -35,29 +37,75 @@ impl Features {
                 c - n * d
             })
             .collect();
-        let orient = s.tri_normal.iter().map(|n| n * n.transpose()).collect();
+        let orient = s
+            .tri_normal
+            .iter()
+            .map(|n| {
+                [
+                    n.x * n.x,
+                    n.x * n.y,
+                    n.x * n.z,
+                    n.y * n.y,
+                    n.y * n.z,
+                    n.z * n.z,
+                ]
+            })
+            .collect();
         Features { pos, orient }
     }
 }
 
-/// Squared feature distance between triangle `t` and a centre `(c, m, |m|²)`.
+/// A patch triangle's features, gathered in one place for the passes of [`kmeans`].
+#[derive(Clone, Copy)]
+struct Feat {
+    pos: [f64; 3],
+    orient: Sym,
+}
+
+/// A k-means centre: mean position, mean `n·nᵀ` and its squared Frobenius norm.
+#[derive(Clone, Copy)]
+struct Centre {
+    pos: [f64; 3],
+    orient: Sym,
+    norm2: f64,
+}
+
+impl Centre {
+    /// The squared Frobenius norm is summed as nalgebra sums a `Matrix3`'s (column by column,
+    /// each column's squares left to right), so the clustering is the same, bit for bit, as
+    /// when the features were `Matrix3`s.
+    fn new(pos: [f64; 3], m: Sym) -> Centre {
+        let col = |a: f64, b: f64, c: f64| a * a + b * b + c * c;
+        let norm2 = col(m[0], m[1], m[2]) + col(m[1], m[3], m[4]) + col(m[2], m[4], m[5]);
+        Centre {
+            pos,
+            orient: m,
+            norm2,
+        }
+    }
+}
+
+/// Squared feature distance between a triangle and a centre: squared distance of the
+/// positions plus `lambda²·|n nᵀ − M|²_F = lambda²·(1 − 2 nᵀMn + |M|²)`, with `nᵀMn` the
+/// Frobenius product `⟨n nᵀ, M⟩`, summed in the column-major order of a `Matrix3`'s
+/// `component_mul(..).sum()` (each off-diagonal product twice).
 #[inline]
-fn dist2(f: &Features, t: usize, c: &(P3, Matrix3<f64>, f64), lambda2: f64) -> f64 {
-    let n_m_n = {
-        let o = &f.orient[t];
-        // nᵀ M n = ⟨n nᵀ, M⟩ (Frobenius)
-        o.component_mul(&c.1).sum()
-    };
-    (f.pos[t] - c.0).norm_squared() + lambda2 * (1.0 - 2.0 * n_m_n + c.2)
+fn dist2(x: &Feat, c: &Centre, lambda2: f64) -> f64 {
+    let (o, m) = (&x.orient, &c.orient);
+    let (d00, d01, d02) = (o[0] * m[0], o[1] * m[1], o[2] * m[2]);
+    let (d11, d12, d22) = (o[3] * m[3], o[4] * m[4], o[5] * m[5]);
+    let n_m_n = d00 + d01 + d02 + d01 + d11 + d12 + d02 + d12 + d22;
+    let (dx, dy, dz) = (
+        x.pos[0] - c.pos[0],
+        x.pos[1] - c.pos[1],
+        x.pos[2] - c.pos[2],
+    );
+    (dx * dx + dy * dy + dz * dz) + lambda2 * (1.0 - 2.0 * n_m_n + c.norm2)
 }
 
 /// Fewest triangles a thread takes at a time: the polishing's 2-means of a patch of a few
 /// hundred triangles runs on one, where splitting it cost more than it saved.
 const MIN_LEN: usize = 1024;
-
-fn centre(p: P3, m: Matrix3<f64>) -> (P3, Matrix3<f64>, f64) {
-    (p, m, m.norm_squared())
-}
 
 /// Split the triangles `tris` into at most `k` patches. Deterministic; patches ordered by their
 /// first triangle, each patch's triangles ascending.
@@ -74,15 +122,24 @@ pub fn kmeans(
     }
     let k = k.clamp(1, tris.len());
     let lambda2 = lambda * lambda;
-    let total_w: f64 = tris
+    // The features of the patch in a row: the passes below read them in order.
+    let feats: Vec<Feat> = tris
         .iter()
-        .map(|&t| s.tri_area[t as usize])
-        .sum::<f64>()
-        .max(1e-300);
+        .map(|&t| {
+            let p = f.pos[t as usize];
+            Feat {
+                pos: [p.x, p.y, p.z],
+                orient: f.orient[t as usize],
+            }
+        })
+        .collect();
+    let areas: Vec<f64> = tris.iter().map(|&t| s.tri_area[t as usize]).collect();
+    let total_w: f64 = areas.iter().sum::<f64>().max(1e-300);
     let mean = P3::from(
-        tris.iter().fold(V3::zeros(), |a, &t| {
-            a + f.pos[t as usize].coords * s.tri_area[t as usize]
-        }) / total_w,
+        tris.iter()
+            .zip(&areas)
+            .fold(V3::zeros(), |a, (&t, &w)| a + f.pos[t as usize].coords * w)
+            / total_w,
     );
     // Farthest-point seeding in feature space, starting from the triangle farthest from the
     // area-weighted mean.
@@ -93,12 +150,12 @@ pub fn kmeans(
             di.total_cmp(&dj).then(j.cmp(&i))
         })
         .unwrap();
-    let seed = |t: usize| centre(f.pos[t], f.orient[t]);
-    let mut centres = vec![seed(tris[first] as usize)];
-    let mut best: Vec<f64> = tris
+    let seed = |i: usize| Centre::new(feats[i].pos, feats[i].orient);
+    let mut centres = vec![seed(first)];
+    let mut best: Vec<f64> = feats
         .par_iter()
         .with_min_len(MIN_LEN)
-        .map(|&t| dist2(f, t as usize, &centres[0], lambda2))
+        .map(|x| dist2(x, &centres[0], lambda2))
         .collect();
     while centres.len() < k {
         let (i, d) = best
@@ -109,25 +166,25 @@ pub fn kmeans(
         if *d <= 1e-300 {
             break;
         }
-        let c = seed(tris[i] as usize);
+        let c = seed(i);
         best.par_iter_mut()
-            .zip(tris.par_iter())
+            .zip(feats.par_iter())
             .with_min_len(MIN_LEN)
-            .for_each(|(b, &u)| {
-                *b = b.min(dist2(f, u as usize, &c, lambda2));
+            .for_each(|(b, x)| {
+                *b = b.min(dist2(x, &c, lambda2));
             });
         centres.push(c);
     }
     let mut assign: Vec<usize> = vec![usize::MAX; tris.len()];
     for _ in 0..iters.max(1) {
-        let new: Vec<usize> = tris
+        let new: Vec<usize> = feats
             .par_iter()
             .with_min_len(MIN_LEN)
-            .map(|&t| {
+            .map(|x| {
                 let mut bi = 0;
                 let mut bd = f64::INFINITY;
                 for (ci, c) in centres.iter().enumerate() {
-                    let d = dist2(f, t as usize, c, lambda2);
+                    let d = dist2(x, c, lambda2);
                     if d < bd {
                         bd = d;
                         bi = ci;
@@ -141,17 +198,20 @@ pub fn kmeans(
         }
         assign = new;
         // Update (sequential sums: a fixed order keeps the result bit-identical).
-        let mut acc = vec![(V3::zeros(), Matrix3::zeros(), 0.0f64); centres.len()];
-        for (i, &t) in tris.iter().enumerate() {
-            let w = s.tri_area[t as usize];
-            let a = &mut acc[assign[i]];
-            a.0 += f.pos[t as usize].coords * w;
-            a.1 += f.orient[t as usize] * w;
+        let mut acc = vec![([0.0f64; 3], [0.0f64; 6], 0.0f64); centres.len()];
+        for ((x, &w), &ci) in feats.iter().zip(&areas).zip(&assign) {
+            let a = &mut acc[ci];
+            for (s, v) in a.0.iter_mut().zip(x.pos) {
+                *s += v * w;
+            }
+            for (s, v) in a.1.iter_mut().zip(x.orient) {
+                *s += v * w;
+            }
             a.2 += w;
         }
         for (c, a) in centres.iter_mut().zip(&acc) {
             if a.2 > 0.0 {
-                *c = centre(P3::from(a.0 / a.2), a.1 / a.2);
+                *c = Centre::new(a.0.map(|v| v / a.2), a.1.map(|v| v / a.2));
             }
         }
     }
