@@ -325,9 +325,18 @@ type PartKey = (Vec<u32>, Vec<[u64; 4]>);
 /// try the same merges and splits again from round to round (on the GSO mug 5,245 of 17,549
 /// builds repeated an earlier one). `build_part` is a pure function of its key, so a part
 /// taken from here is the one it would build; the parallel callers may both build a missing
-/// one, and insert the same. Emptied once the patches are final.
+/// one, and insert the same. Likewise the 2-means halves of a patch that [`split_ways`] tries
+/// first, by the patch's triangles: the rebalancing tries a border move between the same two
+/// patches again after moves elsewhere (on the GSO TROCHILUS shoe a fifth of the triangles
+/// split were split before). Emptied once the patches are final.
 #[derive(Clone, Debug, Default)]
-struct Memo(std::sync::Arc<Mutex<std::collections::HashMap<PartKey, Built, KeyHash>>>);
+struct Memo {
+    parts: Shared<PartKey, Built>,
+    halves: Shared<Vec<u32>, Vec<Vec<u32>>>,
+}
+
+/// A map the parallel builds of one `Params` share.
+type Shared<K, V> = std::sync::Arc<Mutex<std::collections::HashMap<K, V, KeyHash>>>;
 
 /// The memo's hasher: a multiply-rotate hash of 8 bytes at a time (as rustc's `FxHasher`).
 /// A key holds a patch's triangle list, hundreds of indices: SipHash, made to resist chosen
@@ -395,12 +404,12 @@ impl Memo {
     }
 
     fn get(&self, k: &PartKey) -> Option<Built> {
-        self.0.lock().ok()?.get(k).cloned()
+        self.parts.lock().ok()?.get(k).cloned()
     }
 
     /// Keep `v` unless what is kept already says more: a built part, or a higher bound.
     fn put(&self, k: PartKey, v: Built) {
-        if let Ok(mut m) = self.0.lock() {
+        if let Ok(mut m) = self.parts.lock() {
             let more = match (m.get(&k), &v) {
                 (Some(Built::Done(_)), _) => false,
                 (Some(Built::Above(old)), Built::Above(new)) => new > old,
@@ -412,8 +421,24 @@ impl Memo {
         }
     }
 
+    /// The 2-means halves of the patch `tris`, by `kmeans` (a pure function of them) when not
+    /// kept yet.
+    fn halves(&self, tris: &[u32], kmeans: impl FnOnce() -> Vec<Vec<u32>>) -> Vec<Vec<u32>> {
+        if let Some(h) = self.halves.lock().ok().and_then(|m| m.get(tris).cloned()) {
+            return h;
+        }
+        let h = kmeans();
+        if let Ok(mut m) = self.halves.lock() {
+            m.insert(tris.to_vec(), h.clone());
+        }
+        h
+    }
+
     fn clear(&self) {
-        if let Ok(mut m) = self.0.lock() {
+        if let Ok(mut m) = self.parts.lock() {
+            m.clear();
+        }
+        if let Ok(mut m) = self.halves.lock() {
             m.clear();
         }
     }
@@ -1527,7 +1552,9 @@ fn split_ways(
     }
     debug_assert!(part.tris.is_sorted(), "a patch's triangles are ascending");
     let mut cands: Vec<(Vec<u32>, Vec<u32>)> = Vec::new();
-    let halves = patches::kmeans(s, f, &part.tris, 2, p.lambda, 12);
+    let halves = p.memo.halves(&part.tris, || {
+        patches::kmeans(s, f, &part.tris, 2, p.lambda, 12)
+    });
     if let [a, b] = &halves[..] {
         cands.push((a.clone(), b.clone()));
     }
