@@ -16,8 +16,9 @@
 //! `--quick`: three small fixture meshes (CI). `--ref-dir DIR`: keep (and resume) the Python
 //! reference runs in DIR (with `--no-python`: only read its `results.json`). `--repeat N`: our
 //! engine's time is the median of N runs, which must all give the same hulls. `--max-hulls N`:
-//! our engine's hull budget (default 32; CoACD 32×64 and V-HACD 4 keep 32). Without the
-//! Python packages the reference columns read "n/a".
+//! our engine's hull budget (default 32; CoACD 32×64 and V-HACD 4 keep 32). `--engines LIST`:
+//! the reference engines run (default `coacd,coacd32,vhacd`). Without the Python packages the
+//! reference columns read "n/a".
 
 use interact3d::decompose::scene_aware::{metrics, SceneAware};
 use interact3d::decompose::{vhacd, DecomposeOptions, Hull};
@@ -254,6 +255,9 @@ fn main() {
         .and_then(|n| n.parse().ok())
         .unwrap_or(1)
         .max(1);
+    // `--engines LIST`: the reference engines to run (CoACD at its defaults takes minutes a
+    // scan: `coacd32,vhacd` leaves it out, its column then reads "n/a").
+    let engines = value("--engines").map_or("coacd,coacd32,vhacd", |e| e.as_str());
     let key = |si: usize, oi: usize| format!("s{si:02}_o{oi:02}");
     let mut py: BTreeMap<String, serde_json::Value> = BTreeMap::new();
     if !no_python {
@@ -272,7 +276,7 @@ fn main() {
             .arg("--out")
             .arg(tmp)
             .arg("--engines")
-            .arg("coacd,coacd32,vhacd")
+            .arg(engines)
             .status();
         eprintln!(
             "python done in {:.0} s ({:?})",
