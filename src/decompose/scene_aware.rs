@@ -1555,8 +1555,9 @@ fn split_ways(
     let halves = p.memo.halves(&part.tris, || {
         patches::kmeans(s, f, &part.tris, 2, p.lambda, 12)
     });
-    if let [a, b] = &halves[..] {
-        cands.push((a.clone(), b.clone()));
+    // The memo hands back its own copy: the halves move into the candidates.
+    if let Ok([a, b]) = <[Vec<u32>; 2]>::try_from(halves) {
+        cands.push((a, b));
     }
     // PCA of the area-weighted mid-wall positions.
     let w: f64 = part.tris.iter().map(|&t| s.tri_area[t as usize]).sum();
