@@ -273,7 +273,8 @@ fn github_matrix_jobs_on_separate_machines_merge_from_their_artifacts() {
                     "{} collides",
                     rel.display()
                 );
-                assert!(rel.starts_with(".interact3d-"), "{}", rel.display());
+                let name = rel.to_string_lossy();
+                assert!(name.starts_with(".interact3d-"), "{name}");
             }
             std::fs::create_dir_all(dest.parent().unwrap()).unwrap();
             std::fs::copy(&f, &dest).unwrap();
