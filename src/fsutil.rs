@@ -1,7 +1,35 @@
 //! File-system helpers: atomic writes, atomic output folders, stable JSON.
+//!
+//! Entry points: [`write`], [`write_atomically`], [`write_new_atomically`],
+//! [`write_dir_atomically`], [`create_dir`], [`json_bytes`]. Files and folders made through a temporary path get the modes a plain
+//! `create` would give them (0666 / 0777 less the umask: 0644 / 0755 under the usual 022), not
+//! the owner-only modes of temporary files, so other users and web servers can read the output.
 
 use crate::error::{Error, Result};
 use std::path::Path;
+
+/// The mode asked for when creating a file (the kernel takes the umask off).
+#[cfg(unix)]
+fn file_mode() -> std::fs::Permissions {
+    std::os::unix::fs::PermissionsExt::from_mode(0o666)
+}
+
+/// The mode asked for when creating a folder (the kernel takes the umask off).
+#[cfg(unix)]
+fn dir_mode() -> std::fs::Permissions {
+    std::os::unix::fs::PermissionsExt::from_mode(0o777)
+}
+
+/// A temporary-path builder whose files and folders honour the umask like a plain create.
+fn builder<'a>(prefix: &'a str, dir: bool) -> tempfile::Builder<'a, 'a> {
+    let mut b = tempfile::Builder::new();
+    b.prefix(prefix);
+    #[cfg(unix)]
+    b.permissions(if dir { dir_mode() } else { file_mode() });
+    #[cfg(not(unix))]
+    let _ = dir;
+    b
+}
 
 /// Write a file (the parent must exist).
 pub fn write(path: &Path, bytes: &[u8]) -> Result<()> {
@@ -14,13 +42,30 @@ pub fn write_atomically(path: &Path, bytes: &[u8]) -> Result<()> {
         .parent()
         .filter(|p| !p.as_os_str().is_empty())
         .unwrap_or(Path::new("."));
-    let mut tmp = tempfile::Builder::new()
-        .prefix(".interact3d-")
+    let mut tmp = builder(".interact3d-", false)
         .tempfile_in(dir)
         .map_err(|e| Error::io(dir, e))?;
     std::io::Write::write_all(&mut tmp, bytes).map_err(|e| Error::io(path, e))?;
     tmp.persist(path).map_err(|e| Error::io(path, e.error))?;
     Ok(())
+}
+
+/// Like [`write_atomically`], but never replaces: `Ok(false)` when `path` already exists (made
+/// by another process, perhaps at the same moment), `Ok(true)` when this call created it.
+pub fn write_new_atomically(path: &Path, bytes: &[u8]) -> Result<bool> {
+    let dir = path
+        .parent()
+        .filter(|p| !p.as_os_str().is_empty())
+        .unwrap_or(Path::new("."));
+    let mut tmp = builder(".interact3d-", false)
+        .tempfile_in(dir)
+        .map_err(|e| Error::io(dir, e))?;
+    std::io::Write::write_all(&mut tmp, bytes).map_err(|e| Error::io(path, e))?;
+    match tmp.persist_noclobber(path) {
+        Ok(_) => Ok(true),
+        Err(e) if e.error.kind() == std::io::ErrorKind::AlreadyExists => Ok(false),
+        Err(e) => Err(Error::io(path, e.error)),
+    }
 }
 
 /// Create a folder and its parents.
@@ -77,8 +122,7 @@ pub fn write_dir_atomically(
         .filter(|p| !p.as_os_str().is_empty())
         .unwrap_or(Path::new("."));
     create_dir(parent)?;
-    let tmp = tempfile::Builder::new()
-        .prefix(".interact3d-tmp-")
+    let tmp = builder(".interact3d-tmp-", true)
         .tempdir_in(parent)
         .map_err(|e| Error::io(parent, e))?;
     fill(tmp.path())?;
@@ -102,4 +146,48 @@ pub fn write_dir_atomically(
         return Err(Error::io(out, e));
     }
     Ok(())
+}
+
+#[cfg(all(test, target_os = "linux"))]
+mod tests {
+    use super::*;
+    use std::os::unix::fs::PermissionsExt;
+
+    /// This process's umask, as the kernel reports it.
+    fn umask() -> u32 {
+        let status = std::fs::read_to_string("/proc/self/status").unwrap();
+        let line = status.lines().find(|l| l.starts_with("Umask:")).unwrap();
+        u32::from_str_radix(line["Umask:".len()..].trim(), 8).unwrap()
+    }
+
+    fn mode(p: &Path) -> u32 {
+        std::fs::metadata(p).unwrap().permissions().mode() & 0o777
+    }
+
+    #[test]
+    fn atomic_writes_get_the_modes_of_a_plain_create() {
+        let t = tempfile::tempdir().unwrap();
+        let u = umask();
+        // The kernel's own answer for a plain create in the same folder.
+        write(&t.path().join("plain.txt"), b"x").unwrap();
+        std::fs::create_dir(t.path().join("plain_dir")).unwrap();
+        assert_eq!(mode(&t.path().join("plain.txt")), 0o666 & !u);
+        assert_eq!(mode(&t.path().join("plain_dir")), 0o777 & !u);
+
+        let f = t.path().join("atomic.json");
+        write_atomically(&f, b"{}").unwrap();
+        assert_eq!(mode(&f), mode(&t.path().join("plain.txt")), "umask {u:o}");
+        // Replacing a file keeps the rule (the new file is a new inode).
+        write_atomically(&f, b"{ }").unwrap();
+        assert_eq!(mode(&f), 0o666 & !u);
+
+        let d = t.path().join("folder");
+        write_dir_atomically(&d, false, |tmp| write(&tmp.join("a.txt"), b"a")).unwrap();
+        assert_eq!(mode(&d), mode(&t.path().join("plain_dir")), "umask {u:o}");
+        assert_eq!(mode(&d.join("a.txt")), 0o666 & !u);
+        // Under the usual umask that is readable by everyone.
+        if u == 0o022 {
+            assert_eq!((mode(&f), mode(&d)), (0o644, 0o755));
+        }
+    }
 }

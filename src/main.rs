@@ -219,9 +219,14 @@ struct BatchArgs {
     /// Scenes converted at once (default: all cores).
     #[arg(short, long, value_name = "N")]
     jobs: Option<usize>,
-    /// Process only shard I of N (1-based; by a hash of each scene's relative path).
-    #[arg(long, value_name = "I/N")]
-    shard: Option<interact3d::batch::Shard>,
+    /// Process only shard I of N (1-based; by a hash of each scene's relative path), or `auto`:
+    /// I and N from a Slurm array, a Kubernetes Indexed Job or an AWS Batch array job.
+    #[arg(long, value_name = "I/N|auto")]
+    shard: Option<interact3d::batch::ShardArg>,
+    /// Shard count for --shard auto where the scheduler does not give it (Kubernetes, AWS
+    /// Batch); also read from INTERACT3D_SHARDS.
+    #[arg(long, value_name = "N", requires = "shard")]
+    shards: Option<usize>,
     /// Continue an earlier run in OUT (required to exist); finished scenes are reused.
     #[arg(long)]
     resume: bool,
@@ -229,7 +234,7 @@ struct BatchArgs {
     #[arg(long)]
     force: bool,
     /// Combine shard summaries (summary.shard-I-of-N.json) into OUT/summary.json, .csv, index.html.
-    #[arg(long, conflicts_with_all = ["shard", "resume", "force", "include", "exclude", "list"])]
+    #[arg(long, conflicts_with_all = ["shard", "shards", "resume", "force", "include", "exclude", "list"])]
     merge_reports: bool,
     /// Print the selected scenes (relative paths) on stdout and stop.
     #[arg(long)]
@@ -456,7 +461,13 @@ fn batch(a: BatchArgs) -> Result<ExitCode, Error> {
     opts.include = a.include;
     opts.exclude = a.exclude;
     opts.jobs = a.jobs;
-    opts.shard = a.shard;
+    if let Some(arg) = a.shard {
+        let d = arg.resolve(a.shards)?;
+        if matches!(arg, batch::ShardArg::Auto) {
+            eprintln!("shard {} from {}", d.shard, d.source);
+        }
+        opts.shard = Some(d.shard);
+    }
     opts.resume = a.resume;
     opts.force = a.force;
     opts.progress = match a.progress {

@@ -175,6 +175,41 @@ fn file_identities(out: &Path, made: &[Made]) -> Vec<(String, u64, i128)> {
     v
 }
 
+/// Start `interact3d batch ROOT -o OUT --shard auto` as task `id` of a Slurm array 0..=max,
+/// with the variables sbatch sets (and no other scheduler's).
+fn slurm_task(root: &Path, out: &Path, id: usize, max: usize) -> std::process::Child {
+    let mut args = vec![
+        "batch",
+        root.to_str().unwrap(),
+        "-o",
+        out.to_str().unwrap(),
+        "--jobs",
+        "1",
+        "--progress",
+        "quiet",
+        "--shard",
+        "auto",
+    ];
+    args.extend_from_slice(&FAST);
+    std::process::Command::new(env!("CARGO_BIN_EXE_interact3d"))
+        .args(&args)
+        .env("SLURM_ARRAY_TASK_ID", id.to_string())
+        .env("SLURM_ARRAY_TASK_MIN", "0")
+        .env("SLURM_ARRAY_TASK_MAX", max.to_string())
+        .env("SLURM_ARRAY_TASK_STEP", "1")
+        .env("SLURM_ARRAY_TASK_COUNT", (max + 1).to_string())
+        .env_remove("JOB_COMPLETION_INDEX")
+        .env_remove("AWS_BATCH_JOB_ARRAY_INDEX")
+        .env_remove("INTERACT3D_SHARDS")
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap()
+}
+
+/// Issue #38: three array tasks write into one OUT at the same time (`--shard auto` from the
+/// Slurm variables), one is killed midway and run again with the same index, and the merge
+/// equals a one-machine run: same scene files byte for byte, same summary, CSV and index but
+/// for the times. Also #36: the merged files are readable by others (0644 under umask 022).
 #[test]
 fn shards_cover_every_scene_exactly_once_and_merge_back() {
     let t = tempfile::tempdir().unwrap();
@@ -183,8 +218,8 @@ fn shards_cover_every_scene_exactly_once_and_merge_back() {
         &root,
         Spec {
             good: 9,
-            failing: 0,
-            broken: false,
+            failing: 1,
+            broken: true,
         },
     );
     let out = t.path().join("out");
@@ -195,44 +230,106 @@ fn shards_cover_every_scene_exactly_once_and_merge_back() {
     };
     let all = list(&[]);
     assert_eq!(all, made.iter().map(|m| m.rel.clone()).collect::<Vec<_>>());
-    let mut union = Vec::new();
-    for i in 1..=3 {
-        let part = list(&["--shard", &format!("{i}/3")]);
-        assert!(!part.is_empty(), "shard {i}/3 is empty");
-        union.extend(part);
-    }
+    let parts: Vec<Vec<String>> = (1..=3).map(|i| list(&["--shard", &format!("{i}/3")])).collect();
+    let mut union: Vec<String> = parts.concat();
     union.sort();
     assert_eq!(union, all, "every scene in exactly one shard");
+    assert!(!out.exists(), "--list writes nothing");
 
-    // Three "machines" writing into one shared OUT, then the merge.
-    for i in 1..=3 {
-        let (code, _, err) = batch(&root, &out, &["--jobs", "1", "--shard", &format!("{i}/3")]);
-        assert_eq!(code, 0, "shard {i}/3: {err}");
-        assert!(out.join(format!("summary.shard-{i}-of-3.json")).is_file());
+    // The reference: one process, the whole dataset.
+    let single = t.path().join("single");
+    let (code_single, _, err) = batch(&root, &single, &["--jobs", "1"]);
+    assert_eq!(code_single, 2, "two broken scenes: {err}");
+
+    // Three array tasks (ids 0, 1, 2) at once into a fresh OUT; the biggest shard is killed
+    // as soon as one of its scenes is in place.
+    let victim = (0..3).max_by_key(|&i| parts[i].len()).unwrap();
+    assert!(parts[victim].len() >= 2, "{parts:?}");
+    let mut tasks: Vec<_> = (0..3).map(|id| slurm_task(&root, &out, id, 2)).collect();
+    let done = |rel: &String| out.join(rel).join("batch.json").is_file();
+    let deadline = Instant::now() + Duration::from_secs(120);
+    while !parts[victim].iter().any(done) {
+        assert!(Instant::now() < deadline, "no scene of shard {} in 120 s", victim + 1);
+        assert!(
+            tasks[victim].try_wait().unwrap().is_none(),
+            "shard {} finished before the kill",
+            victim + 1
+        );
+        std::thread::sleep(Duration::from_millis(5));
     }
-    assert!(!out.join("summary.json").exists());
-    let (code, _, err) = run(&["batch", "--merge-reports", "-o", out.to_str().unwrap()]);
-    assert_eq!(code, 0, "{err}");
-    let s = read_json(&out.join("summary.json"));
-    let paths: Vec<&str> = rows(&s)
-        .iter()
-        .map(|r| r["path"].as_str().unwrap())
-        .collect();
-    assert_eq!(paths, all.iter().map(|s| s.as_str()).collect::<Vec<_>>());
-    assert_eq!(s["counts"]["pass"], 9);
-    for m in &made {
-        assert!(out.join(&m.rel).join("batch.json").is_file());
+    tasks[victim].kill().unwrap(); // SIGKILL: a crashed node
+    tasks[victim].wait().unwrap();
+    let finished = parts[victim].iter().filter(|r| done(r)).count();
+    for (i, task) in tasks.into_iter().enumerate().filter(|(i, _)| *i != victim) {
+        let o = task.wait_with_output().unwrap();
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert!(
+            err.contains(&format!("shard {}/3 from Slurm array task {i} of 0..=2", i + 1)),
+            "{err}"
+        );
+        assert!(matches!(o.status.code(), Some(0..=2)), "task {i}: {err}");
+        assert!(out.join(format!("summary.shard-{}-of-3.json", i + 1)).is_file());
     }
-    // Merging with a shard missing says so and exits 2.
-    let (code, _, err) = run(&[
-        "batch",
-        "--merge-reports",
-        "-o",
-        t.path().join("partial").to_str().unwrap(),
-        out.join("summary.shard-1-of-3.json").to_str().unwrap(),
-    ]);
-    assert_eq!(code, 2);
-    assert!(err.contains("missing shard"), "{err}");
+    let victim_summary = out.join(format!("summary.shard-{}-of-3.json", victim + 1));
+    assert!(!victim_summary.exists());
+    // Merging now says a shard is missing (exit 2).
+    let merge = || {
+        std::process::Command::new("sh")
+            .args(["-c", "umask 022; exec \"$0\" \"$@\""])
+            .arg(env!("CARGO_BIN_EXE_interact3d"))
+            .args(["batch", "--merge-reports", "-o", out.to_str().unwrap()])
+            .output()
+            .unwrap()
+    };
+    let m = merge();
+    assert_eq!(m.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&m.stderr).contains("missing shard"));
+
+    // The crashed task is run again with the same array index: its finished scenes are reused.
+    let o = slurm_task(&root, &out, victim, 2).wait_with_output().unwrap();
+    assert!(matches!(o.status.code(), Some(0..=2)), "{}", String::from_utf8_lossy(&o.stderr));
+    let vs = read_json(&victim_summary);
+    assert_eq!(vs["run"]["reused"], finished);
+    assert_eq!(
+        vs["run"]["converted"].as_u64().unwrap() as usize,
+        parts[victim].len() - finished
+    );
+
+    let m = merge();
+    assert_eq!(m.status.code(), Some(code_single), "{}", String::from_utf8_lossy(&m.stderr));
+    // Same files (scene folders byte for byte) apart from the summaries and our hidden files.
+    let summaries = ["summary.json", "summary.csv", "index.html"];
+    let files = |d: &Path| -> Vec<(String, Vec<u8>)> {
+        snapshot(d)
+            .into_iter()
+            .filter(|(f, _)| !summaries.contains(&f.as_str()) && !f.starts_with('.'))
+            .filter(|(f, _)| !f.starts_with("summary.shard-"))
+            .collect()
+    };
+    let (a, b) = (files(&single), files(&out));
+    assert_eq!(
+        a.iter().map(|x| &x.0).collect::<Vec<_>>(),
+        b.iter().map(|x| &x.0).collect::<Vec<_>>(),
+        "same files"
+    );
+    assert!(a.len() > 30);
+    for (x, y) in a.iter().zip(&b) {
+        assert!(x.1 == y.1, "{} differs", x.0);
+    }
+    let merged = read_json(&out.join("summary.json"));
+    assert_eq!(merged["counts"]["scenes"], made.len());
+    assert_eq!(stable(read_json(&single.join("summary.json"))), stable(merged));
+    let csv = |d: &Path| stable_csv(&std::fs::read_to_string(d.join("summary.csv")).unwrap());
+    assert_eq!(csv(&single), csv(&out));
+    let html = |d: &Path| stable_html(&std::fs::read_to_string(d.join("index.html")).unwrap());
+    assert_eq!(html(&single), html(&out));
+
+    // Readable by other users and web servers, as export files are.
+    use std::os::unix::fs::PermissionsExt;
+    let mode = |p: &Path| std::fs::metadata(p).unwrap().permissions().mode() & 0o777;
+    for f in ["summary.json", "summary.csv", "index.html"] {
+        assert_eq!(mode(&out.join(f)), 0o644, "{f}");
+    }
 }
 
 /// The summary without what legitimately differs between runs: timings, reuse flags, run info.

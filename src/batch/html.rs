@@ -1,6 +1,7 @@
 //! `OUT/index.html`: one self-contained page (inline CSS and JavaScript, no network) to browse a
 //! batch: counts, a sortable table, filters by verdict and category, a text filter, and links to
-//! each scene's files.
+//! each scene's files. The time column shows conversion times; a scene reused from an earlier
+//! run says "reused" (the run only checked its hash). Entry point: [`page`].
 
 use super::summary::Summary;
 use crate::error::{Error, Result};
@@ -63,7 +64,7 @@ const COLS = [
   ["verdict", "verdict", "text"], ["r_volume", "R_volume", "num"],
   ["max_penetration_m", "max penetration (mm)", "mm"], ["collision_penetration_m", "hull penetration (mm)", "mm"],
   ["max_displacement_m", "max displacement (mm)", "mm"], ["hulls", "hulls", "list"],
-  ["time_s", "time (s)", "num"], ["files", "files", "files"], ["error", "error / failed checks", "msg"]
+  ["time_s", "conversion time (s)", "time"], ["files", "files", "files"], ["error", "error / failed checks", "msg"]
 ];
 let sortKey = "path", sortDir = 1;
 const el = (tag, props, kids) => {
@@ -81,6 +82,7 @@ function fmt(v, kind) {
 function value(r, key) {
   if (key === "hulls") return r.hulls.reduce((a, b) => a + b, 0);
   if (key === "error") return r.error || r.failed_checks.join("; ");
+  if (key === "time_s" && r.reused) return null;
   return r[key];
 }
 function cmp(a, b) {
@@ -105,8 +107,9 @@ function render() {
         [i ? " " : "", el("a", { href: base + f, textContent: f.replace(/\.\w+$/, "") })]
       ).concat([" ", el("a", { href: base, textContent: "folder" })]));
     }
-    const td = el("td", { textContent: kind === "list" ? r[key].join(" ") : fmt(value(r, key), kind) });
-    if (kind === "num" || kind === "mm") td.className = "num";
+    const td = el("td", { textContent: kind === "list" ? r[key].join(" ")
+      : kind === "time" && r.reused ? "reused" : fmt(value(r, key), kind === "time" ? "num" : kind) });
+    if (kind === "num" || kind === "mm" || kind === "time") td.className = "num";
     if (key === "verdict") td.className = r.verdict;
     if (kind === "msg") td.className = "msg";
     return td;

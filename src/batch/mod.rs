@@ -13,13 +13,24 @@
 //!   verdict `error` and the batch goes on.
 //! * **Bounded memory**: rayon workers take scenes from the list and send a small [`Row`] to the
 //!   collector as each finishes; meshes and reports live only while their scene is in flight.
+//! * **Shards sharing one OUT** (cluster array jobs, [`scheduler`] for `--shard auto`): a scene
+//!   belongs to exactly one shard, so no two shards write the same scene folder; each shard has
+//!   its own staging folder, held by a lock file (`.interact3d-staging-I-of-N.lock`) so a second
+//!   process of the same shard stops at once, and its own summary `summary.shard-I-of-N.json`.
+//!   The marker is created once (no replacing), and OUT counts as empty while it holds only our
+//!   hidden files, so shards starting together on a fresh OUT do not refuse each other. A
+//!   crashed shard is resumed by running the same index again.
+//!
+//! Entry points: [`run`], [`run_with`], [`scenes`], [`merge_reports`], [`counts_line`].
 
 pub mod discover;
 pub mod hash;
 mod html;
+pub mod scheduler;
 pub mod summary;
 
 pub use discover::{SceneEntry, SceneKind, Shard};
+pub use scheduler::ShardArg;
 pub use summary::{Counts, Row, RunInfo, SceneRecord, SceneResult, Summary, Verdict};
 
 use crate::error::{Error, Result};
@@ -112,6 +123,8 @@ pub fn run_with(opts: &BatchOptions, worker: &Worker<'_>) -> Result<Summary> {
         None => ".interact3d-staging".to_string(),
         Some(s) => format!(".interact3d-staging-{}-of-{}", s.index, s.count),
     });
+    // Held until this function returns: the staging folder and the shard's summary are ours.
+    let _lock = lock(&staging, opts.shard)?;
     // Whatever a killed run left in our staging folder is incomplete by construction.
     if staging.exists() {
         std::fs::remove_dir_all(&staging).map_err(|e| Error::io(&staging, e))?;
@@ -196,8 +209,12 @@ fn prepare_out(opts: &BatchOptions) -> Result<()> {
             out.display()
         )));
     }
+    // Our hidden files (another shard's staging folder, lock or half-written marker) do not make
+    // OUT foreign: shards starting together on a fresh OUT would otherwise refuse each other.
     let empty = std::fs::read_dir(out)
-        .map(|mut it| it.next().is_none())
+        .map(|mut it| {
+            it.all(|e| e.is_ok_and(|e| e.file_name().to_string_lossy().starts_with(".interact3d")))
+        })
         .unwrap_or(true);
     if !is_batch && !empty && !opts.force {
         return Err(Error::Usage(format!(
@@ -207,9 +224,42 @@ fn prepare_out(opts: &BatchOptions) -> Result<()> {
     }
     crate::fsutil::create_dir(out)?;
     if !is_batch {
-        crate::fsutil::write_atomically(&marker, MARKER_TEXT.as_bytes())?;
+        // Created once: a shard that lost the race leaves the winner's marker alone.
+        crate::fsutil::write_new_atomically(&marker, MARKER_TEXT.as_bytes())?;
     }
     Ok(())
+}
+
+/// Take the lock of a staging folder (`<staging>.lock`, kept empty and never removed, so every
+/// process locks the same inode). A second process of the same shard stops here with a usage
+/// error rather than clearing the first one's staging folder under it.
+fn lock(staging: &Path, shard: Option<Shard>) -> Result<std::fs::File> {
+    let mut name = staging.as_os_str().to_owned();
+    name.push(".lock");
+    let path = PathBuf::from(name);
+    let file = std::fs::OpenOptions::new()
+        .create(true)
+        .truncate(false)
+        .write(true)
+        .open(&path)
+        .map_err(|e| Error::io(&path, e))?;
+    match file.try_lock() {
+        Ok(()) => Ok(file),
+        Err(std::fs::TryLockError::WouldBlock) => Err(Error::Usage(format!(
+            "another interact3d batch is running {} in this OUT (it holds {}); \
+             wait for it to end or stop it",
+            shard.map_or("the whole selection".to_string(), |s| format!("shard {s}")),
+            path.display()
+        ))),
+        // A file system without locks: go on unguarded, as before, but say so.
+        Err(std::fs::TryLockError::Error(e)) => {
+            eprintln!(
+                "warning: cannot lock {} ({e}); make sure no other process runs the same shard",
+                path.display()
+            );
+            Ok(file)
+        }
+    }
 }
 
 struct Ctx<'a> {
@@ -361,9 +411,11 @@ fn collect(rx: std::sync::mpsc::Receiver<Row>, total: usize, progress: Progress)
     });
     let start = Instant::now();
     let mut c = Counts::default();
+    let mut converted = 0usize;
     let mut rows = Vec::with_capacity(total);
     for row in rx {
         c.scenes += 1;
+        converted += usize::from(!row.reused);
         match row.scene.verdict {
             Verdict::Pass => c.pass += 1,
             Verdict::Fail => c.fail += 1,
@@ -377,18 +429,17 @@ fn collect(rx: std::sync::mpsc::Receiver<Row>, total: usize, progress: Progress)
             pb.set_message(counts);
             pb.inc(1);
         } else if progress != Progress::Quiet {
-            let el = start.elapsed().as_secs_f64();
-            let rate = c.scenes as f64 / el.max(1e-9);
-            let eta = (total - c.scenes) as f64 / rate.max(1e-9);
             eprintln!(
-                "[{:>w$}/{total}] {:<5} {}{} ({:.2} s) | {counts} | {:.1} scenes/min, ETA {:.0} s{}",
+                "[{:>w$}/{total}] {:<5} {} ({}) | {counts} | {}{}",
                 c.scenes,
                 row.scene.verdict.as_str(),
                 row.scene.path,
-                if row.reused { " (reused)" } else { "" },
-                row.time_s,
-                rate * 60.0,
-                eta,
+                if row.reused {
+                    "reused".to_string()
+                } else {
+                    format!("{:.2} s", row.time_s)
+                },
+                speed(converted, start.elapsed().as_secs_f64(), total - c.scenes),
                 row.error
                     .as_ref()
                     .map(|e| format!("\n    {e}"))
@@ -402,6 +453,20 @@ fn collect(rx: std::sync::mpsc::Receiver<Row>, total: usize, progress: Progress)
         pb.finish_and_clear();
     }
     rows
+}
+
+/// The conversion speed and ETA: scenes converted (reused ones do not count: checking a hash
+/// is not converting) per minute of wall time, or "reused" while nothing was converted yet.
+fn speed(converted: usize, elapsed_s: f64, left: usize) -> String {
+    if converted == 0 {
+        return "all reused so far".into();
+    }
+    let per_s = converted as f64 / elapsed_s.max(1e-9);
+    format!(
+        "{:.1} scenes/min converting, ETA {:.0} s",
+        per_s * 60.0,
+        left as f64 / per_s
+    )
 }
 
 /// The result of `--merge-reports`.
@@ -434,8 +499,16 @@ pub fn merge_reports(out: &Path, inputs: &[PathBuf]) -> Result<Merged> {
 
 /// One-line text of the counts, for the end of a run.
 pub fn counts_line(s: &Summary) -> String {
+    let rate = if s.run.converted > 0 {
+        format!(
+            ", {:.1} scenes/min converted",
+            s.run.converted as f64 * 60.0 / s.run.elapsed_s.max(1e-3)
+        )
+    } else {
+        String::new()
+    };
     format!(
-        "{} scenes: {} pass, {} fail, {} error ({} converted, {} reused) in {:.1} s",
+        "{} scenes: {} pass, {} fail, {} error ({} converted, {} reused) in {:.1} s{rate}",
         s.counts.scenes,
         s.counts.pass,
         s.counts.fail,

@@ -180,3 +180,61 @@ fn csv_quotes_what_needs_quoting() {
     assert_eq!(summary::csv_field("say \"x\""), "\"say \"\"x\"\"\"");
     assert_eq!(summary::csv_field("plain"), "plain");
 }
+
+#[test]
+fn a_second_process_of_the_same_shard_is_refused_and_others_go_on() {
+    let t = tempfile::tempdir().unwrap();
+    let root = t.path().join("root");
+    let names: Vec<String> = (0..6).map(|i| format!("c/{i:05}_s")).collect();
+    dataset(&root, &names.iter().map(|s| s.as_str()).collect::<Vec<_>>());
+    let out = t.path().join("out");
+    std::fs::create_dir_all(&out).unwrap();
+    // Another process holds shard 1/2 (an open file lock, as run() takes it) and has started
+    // its staging folder; OUT has no marker yet, which must not make shard 2 refuse OUT.
+    let held = std::fs::File::create(out.join(".interact3d-staging-1-of-2.lock")).unwrap();
+    held.try_lock().unwrap();
+    std::fs::create_dir(out.join(".interact3d-staging-1-of-2")).unwrap();
+    let calls = AtomicUsize::new(0);
+    let mut opts = BatchOptions::new(&root, &out, ExportJob::default());
+    opts.progress = Progress::Quiet;
+    opts.shard = Some(Shard { index: 1, count: 2 });
+    let e = run_with(&opts, &worker(&calls)).unwrap_err().to_string();
+    assert!(e.contains("another interact3d batch is running shard 1/2"), "{e}");
+    assert_eq!(calls.load(Ordering::SeqCst), 0);
+    assert!(out.join(".interact3d-staging-1-of-2").is_dir(), "left alone");
+    opts.shard = Some(Shard { index: 2, count: 2 });
+    let s = run_with(&opts, &worker(&calls)).unwrap();
+    assert_eq!(s.counts.scenes, calls.load(Ordering::SeqCst));
+    drop(held);
+    opts.shard = Some(Shard { index: 1, count: 2 });
+    let s1 = run_with(&opts, &worker(&calls)).unwrap();
+    assert_eq!(s.counts.scenes + s1.counts.scenes, 6);
+    // The marker was created once and is readable like any file made with the umask.
+    use std::os::unix::fs::PermissionsExt;
+    let mode = |p: &Path| std::fs::metadata(p).unwrap().permissions().mode() & 0o777;
+    std::fs::write(t.path().join("plain"), b"").unwrap();
+    for f in [MARKER, "summary.shard-1-of-2.json", "summary.shard-2-of-2.json"] {
+        assert_eq!(mode(&out.join(f)), mode(&t.path().join("plain")), "{f}");
+    }
+}
+
+#[test]
+fn a_run_that_reuses_everything_reports_no_speed() {
+    let t = tempfile::tempdir().unwrap();
+    let root = t.path().join("root");
+    dataset(&root, &["a/00001_ok", "a/00002_ok"]);
+    let out = t.path().join("out");
+    let calls = AtomicUsize::new(0);
+    let mut opts = BatchOptions::new(&root, &out, ExportJob::default());
+    opts.progress = Progress::Quiet;
+    let first = run_with(&opts, &worker(&calls)).unwrap();
+    assert!(counts_line(&first).contains("scenes/min converted"));
+    let again = run_with(&opts, &worker(&calls)).unwrap();
+    assert_eq!((again.run.converted, again.run.reused), (0, 2));
+    let line = counts_line(&again);
+    assert!(!line.contains("scenes/min"), "{line}");
+    assert_eq!(speed(0, 1e-4, 3), "all reused so far");
+    // 2 converted in 30 s: 4 per minute, 1 left: 15 s.
+    assert_eq!(speed(2, 30.0, 1), "4.0 scenes/min converting, ETA 15 s");
+    assert!(again.scenes.iter().all(|r| r.reused));
+}
