@@ -148,6 +148,9 @@ fn check_engines(scene: &Path, extra: &[&str]) {
 
 #[test]
 fn fixtures_load_in_mujoco_and_pybullet() {
+    if !python_or_skip("interop::fixtures_load_in_mujoco_and_pybullet") {
+        return;
+    }
     let fx = fixtures();
     assert!(fx.len() >= 4, "fixtures/ must hold the generated scenes");
     for f in fx {
@@ -157,11 +160,11 @@ fn fixtures_load_in_mujoco_and_pybullet() {
 
 #[test]
 fn shared_scenes_load_in_mujoco_and_pybullet() {
-    let scenes = shared_scenes();
-    if !shared().exists() {
-        eprintln!("../shared not present: skipped");
+    const TEST: &str = "interop::shared_scenes_load_in_mujoco_and_pybullet";
+    if shared_or_skip(TEST, "datasets/scenes").is_none() || !python_or_skip(TEST) {
         return;
     }
+    let scenes = shared_scenes();
     assert!(scenes.len() >= 10);
     for s in scenes {
         check_engines(&s, &[]);
@@ -170,9 +173,11 @@ fn shared_scenes_load_in_mujoco_and_pybullet() {
 
 #[test]
 fn real_scans_load_in_mujoco_and_pybullet() {
-    let base = shared().join("datasets/objects");
-    if !base.exists() {
-        eprintln!("../shared not present: skipped");
+    const TEST: &str = "interop::real_scans_load_in_mujoco_and_pybullet";
+    let Some(base) = shared_or_skip(TEST, "datasets/objects") else {
+        return;
+    };
+    if !python_or_skip(TEST) {
         return;
     }
     for (mesh, extra) in [
