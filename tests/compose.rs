@@ -5,7 +5,7 @@
 
 mod common;
 
-use common::{root, run, shared};
+use common::{root, run, shared_or_skip};
 use interact3d::compose::synth;
 use interact3d::pose::Similarity;
 use std::path::Path;
@@ -70,8 +70,10 @@ fn compose_and_check(src: &Path, seed: u64, tmp: &Path) {
     let scene = interact3d::scene::load(&out, &Default::default()).unwrap();
     assert_eq!(scene.objects.len(), s.inputs.len());
     for o in &scene.objects {
+        // Named from the labels; the mesh file's id (object_b) is the alias.
+        let id = o.aliases.first().unwrap_or(&o.name);
         let m: Similarity =
-            interact3d::scene::sample::parse_transform(&reg["transforms"][&o.name]).unwrap();
+            interact3d::scene::sample::parse_transform(&reg["transforms"][id]).unwrap();
         assert!((o.pose.matrix() - m.matrix()).abs().max() < 1e-12);
     }
     // export takes OUT directly.
@@ -123,11 +125,12 @@ fn composes_ball_bowl_from_generated_guidance() {
 
 #[test]
 fn composes_a_shared_real_scan_scene() {
-    let src = shared().join("datasets/scenes/food/00001_lemon_bowl");
-    if !src.is_dir() {
-        eprintln!("skipped: {} not found", src.display());
+    let Some(src) = shared_or_skip(
+        "compose::composes_a_shared_real_scan_scene",
+        "datasets/scenes/food/00001_lemon_bowl",
+    ) else {
         return;
-    }
+    };
     let tmp = tempfile::tempdir().unwrap();
     compose_and_check(&src, 3, tmp.path());
 }
@@ -140,11 +143,12 @@ fn composes_a_shared_real_scan_scene() {
 fn composes_three_shoes_on_a_tray_without_overlap() {
     use interact3d::compose::{compose, ComposeOptions, Method};
     use interact3d::metrics::{pair_metrics, MetricsOptions, Prepared, Solid};
-    let src = shared().join("datasets/scenes/apparel/00005_shoes_tray");
-    if !src.is_dir() {
-        eprintln!("skipped: {} not found", src.display());
+    let Some(src) = shared_or_skip(
+        "compose::composes_three_shoes_on_a_tray_without_overlap",
+        "datasets/scenes/apparel/00005_shoes_tray",
+    ) else {
         return;
-    }
+    };
     let truth = synth::load_truth(&src).unwrap();
     let s = synth::make(&truth, 1000, &synth::SynthOptions::default());
     let o = ComposeOptions {

@@ -232,8 +232,15 @@ pub fn load(path: &Path, limits: &Limits) -> Result<Scene> {
         };
         let mesh_path = resolve_inside(&root, path, &o.mesh)?;
         let visual = crate::io::load_visual(&mesh_path, limits)?;
+        // The mesh file's stem as an alias (a composed sample's `object_b.glb` stays
+        // `object_b` on the command line when the object is called `lemon`).
+        let stem = Path::new(&o.mesh)
+            .file_stem()
+            .map(|s| s.to_string_lossy().into_owned())
+            .filter(|s| super::is_valid_name(s) && s != &o.name);
         objects.push(SceneObject {
             name: o.name.clone(),
+            aliases: stem.into_iter().collect(),
             label: o.label.clone(),
             mesh_path,
             visual,
@@ -246,6 +253,7 @@ pub fn load(path: &Path, limits: &Limits) -> Result<Scene> {
             },
         });
     }
+    super::drop_ambiguous_aliases(&mut objects);
     let name = m.name.clone().unwrap_or_else(|| {
         root.canonicalize()
             .ok()
