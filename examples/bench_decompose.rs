@@ -1,5 +1,6 @@
 //! Decomposition bench: our scene-aware engine against parry's V-HACD and, when Python has
-//! them (`pip install coacd vhacdx`), CoACD and V-HACD 4 run by
+//! them (`pip install -r tests/python/requirements-bench.txt`; the interpreter is
+//! `$INTERACT3D_PYTHON`, default `python3`), CoACD and V-HACD 4 run by
 //! `tests/python/bench_reference.py`. Every engine's hulls are measured by the same code
 //! (`decompose::scene_aware::metrics`): surface distance = points sampled uniformly on the
 //! boundary of the union of the hulls (hull-surface points inside another hull of the same
@@ -269,7 +270,8 @@ fn main() {
         let script = root().join("tests/python/bench_reference.py");
         eprintln!("running CoACD / V-HACD 4 via {} ...", script.display());
         let t = Instant::now();
-        let status = std::process::Command::new("python3")
+        let python = std::env::var("INTERACT3D_PYTHON").unwrap_or_else(|_| "python3".into());
+        let status = std::process::Command::new(python)
             .arg(&script)
             .arg("--in")
             .arg(tmp)

@@ -147,8 +147,19 @@ struct ValidateArgs {
 #[derive(Args)]
 struct BuildArgs {
     /// Longest extent of one object in metres, NAME=METRES; scales the whole scene uniformly.
+    /// NAME is the object's name or alias (a sample's `object_b` as well as its label `lemon`).
     #[arg(long = "size", value_name = "NAME=METRES", value_parser = parse_size)]
     sizes: Vec<(String, f64)>,
+    /// Density of one object in kg/m³, NAME=KG_M3 (default 1000); repeatable.
+    #[arg(long = "density", value_name = "NAME=KG_M3", value_parser = parse_density)]
+    densities: Vec<(String, f64)>,
+    /// Mass of one object in kg, NAME=KG (over any density); repeatable.
+    #[arg(long = "mass", value_name = "NAME=KG", value_parser = parse_mass)]
+    masses: Vec<(String, f64)>,
+    /// Up axis of a lone OBJ/STL mesh (default z) or of a manifest (over its `up_axis`). glTF
+    /// and sample folders are Y-up by the glTF specification.
+    #[arg(long, value_enum, value_name = "AXIS")]
+    up: Option<UpArg>,
     /// Convex decomposition engine.
     #[arg(long, value_enum, default_value_t = Engine::SceneAware)]
     engine: Engine,
@@ -257,6 +268,12 @@ struct BatchArgs {
 }
 
 #[derive(Clone, Copy, clap::ValueEnum)]
+enum UpArg {
+    Y,
+    Z,
+}
+
+#[derive(Clone, Copy, clap::ValueEnum)]
 enum ProgressArg {
     Auto,
     Bar,
@@ -264,19 +281,50 @@ enum ProgressArg {
     Quiet,
 }
 
-fn parse_size(s: &str) -> Result<(String, f64), String> {
-    let (name, v) = s.split_once('=').ok_or("expected NAME=METRES")?;
+/// `NAME=VALUE` with a positive finite value in `unit`.
+fn parse_named(s: &str, what: &str, unit: &str) -> Result<(String, f64), String> {
+    let (name, v) = s
+        .split_once('=')
+        .ok_or_else(|| format!("expected NAME={}", unit.to_ascii_uppercase()))?;
     let v: f64 = v.parse().map_err(|_| format!("{v:?} is not a number"))?;
     if !(v.is_finite() && v > 0.0) {
-        return Err("size must be a positive number of metres".into());
+        return Err(format!("{what} must be a positive number of {unit}"));
     }
     Ok((name.to_string(), v))
+}
+
+fn parse_size(s: &str) -> Result<(String, f64), String> {
+    parse_named(s, "size", "metres")
+}
+
+fn parse_density(s: &str) -> Result<(String, f64), String> {
+    parse_named(s, "density", "kg_m3")
+}
+
+fn parse_mass(s: &str) -> Result<(String, f64), String> {
+    parse_named(s, "mass", "kg")
+}
+
+/// Every warning on stderr, one line each, under the table; then the summary line, which counts
+/// them.
+fn print_warnings_and_summary(warnings: &[String], summary: &str) {
+    for w in warnings {
+        eprintln!("warning: {w}");
+    }
+    let n = warnings.len();
+    eprintln!("{summary}, {n} warning{}", if n == 1 { "" } else { "s" });
 }
 
 impl BuildArgs {
     fn options(&self) -> interact3d::body::BuildOptions {
         let mut o = interact3d::body::BuildOptions::default();
         o.prepare.sizes = self.sizes.iter().cloned().collect();
+        o.prepare.densities = self.densities.iter().cloned().collect();
+        o.prepare.masses = self.masses.iter().cloned().collect();
+        o.prepare.up = self.up.map(|u| match u {
+            UpArg::Y => interact3d::scene::UpAxis::Y,
+            UpArg::Z => interact3d::scene::UpAxis::Z,
+        });
         o.engine = self.engine;
         o.decompose.max_hulls = self.max_hulls;
         o.decompose.max_vertices = self.max_hull_vertices;
@@ -328,13 +376,13 @@ fn run(cli: Cli) -> Result<ExitCode, Error> {
                     }
                 );
             }
-            eprintln!(
-                "exported {} to {} in {:.2} s",
+            let mut summary = format!(
+                "exported {} to {} in {:.2} s: ",
                 report.scene,
                 a.out.display(),
                 t.elapsed().as_secs_f64()
             );
-            match &done.validation {
+            let code = match &done.validation {
                 Some(v) => {
                     eprint!("{}", interact3d::validate::table(v));
                     if let Some(f) = &a.junit {
@@ -343,14 +391,20 @@ fn run(cli: Cli) -> Result<ExitCode, Error> {
                             interact3d::validate::junit(&report.scene, v).as_bytes(),
                         )?;
                     }
-                    Ok(if v.passed {
+                    summary += if v.passed { "PASS" } else { "FAIL" };
+                    if v.passed {
                         ExitCode::SUCCESS
                     } else {
                         ExitCode::from(1)
-                    })
+                    }
                 }
-                None => Ok(ExitCode::SUCCESS),
-            }
+                None => {
+                    summary += "not validated";
+                    ExitCode::SUCCESS
+                }
+            };
+            print_warnings_and_summary(&report.warning_lines(done.validation.as_ref()), &summary);
+            Ok(code)
         }
         Command::Batch(a) => batch(a),
         Command::Compose(a) => {
@@ -394,10 +448,14 @@ fn run(cli: Cli) -> Result<ExitCode, Error> {
                 &a.check.options(),
             )?;
             eprint!("{}", interact3d::validate::table(&v));
-            eprintln!(
-                "validated {} in {:.2} s",
-                assembly.name,
-                t.elapsed().as_secs_f64()
+            print_warnings_and_summary(
+                &interact3d::report::Report::new(&assembly).warning_lines(Some(&v)),
+                &format!(
+                    "validated {} in {:.2} s: {}",
+                    assembly.name,
+                    t.elapsed().as_secs_f64(),
+                    if v.passed { "PASS" } else { "FAIL" }
+                ),
             );
             if a.json {
                 let json =

@@ -17,7 +17,20 @@ pub struct PrepareOptions {
     pub sizes: BTreeMap<String, f64>,
     /// Leave the scene where it is instead of putting its lowest point on z = 0.
     pub keep_height: bool,
+    /// The input's up axis (`--up`), overriding a lone OBJ/STL mesh's Z-up default or a
+    /// manifest's `up_axis`; refused for glTF, which is Y-up by its specification.
+    pub up: Option<UpAxis>,
+    /// Object name (or alias) → density in kg/m³ (`--density NAME=KG_M3`), over the scene's own.
+    pub densities: BTreeMap<String, f64>,
+    /// Object name (or alias) → mass in kg (`--mass NAME=KG`), over the scene's own and over any
+    /// density.
+    pub masses: BTreeMap<String, f64>,
 }
+
+/// A lone object whose longest extent is outside these bounds (metres) gets a warning naming
+/// `--size`: a mesh file carries no unit, and one in millimetres or centimetres read as metres
+/// becomes a 1,000 kg duck.
+pub const LONE_OBJECT_METRES: (f64, f64) = (0.005, 2.0);
 
 /// One object in the world frame (metres, Z-up).
 #[derive(Clone, Debug)]
@@ -59,7 +72,55 @@ fn longest_extent(v: &VisualMesh) -> f64 {
 /// Prepare a loaded scene.
 pub fn prepare(scene: &Scene, opts: &PrepareOptions) -> Result<PreparedScene> {
     let mut warnings = scene.warnings.clone();
-    let up: UnitQuaternion<f64> = match scene.up_axis {
+    let up_axis = match (opts.up, scene.up_axis_fixed()) {
+        (Some(UpAxis::Z), Some(why)) => {
+            return Err(Error::Usage(format!(
+                "--up z does not apply to {}: {why}",
+                scene.source.display()
+            )))
+        }
+        (Some(u), _) => u,
+        (None, _) => scene.up_axis,
+    };
+    let find = |flag: &str, name: &str| {
+        scene.find(name).ok_or_else(|| {
+            Error::Usage(format!(
+                "{flag} names {name:?}, which is not an object of {} (objects: {})",
+                scene.source.display(),
+                scene.names_listed()
+            ))
+        })
+    };
+    let mut physical: BTreeMap<&str, Physical> = scene
+        .objects
+        .iter()
+        .map(|o| (o.name.as_str(), o.physical.clone()))
+        .collect();
+    for (flag, values, unit) in [
+        ("--density", &opts.densities, "kg/m³"),
+        ("--mass", &opts.masses, "kg"),
+    ] {
+        for (name, &v) in values {
+            let o = find(flag, name)?;
+            if !(v.is_finite() && v > 0.0) {
+                return Err(Error::Usage(format!(
+                    "{flag} {name}={v}: must be a positive number of {unit}"
+                )));
+            }
+            let p = physical
+                .get_mut(o.name.as_str())
+                .expect("every object has an entry");
+            if flag == "--mass" {
+                p.mass = Some(v);
+            } else {
+                // A density from the command line replaces a mass the scene gave too (a
+                // `--mass` for the same object, applied next, wins over both).
+                p.density = Some(v);
+                p.mass = None;
+            }
+        }
+    }
+    let up: UnitQuaternion<f64> = match up_axis {
         UpAxis::Y => y_up_to_z_up(),
         UpAxis::Z => UnitQuaternion::identity(),
     };
@@ -67,22 +128,7 @@ pub fn prepare(scene: &Scene, opts: &PrepareOptions) -> Result<PreparedScene> {
     let mut scale = scene.meters_per_unit;
     let mut size_scale: Option<f64> = None;
     for (name, &metres) in &opts.sizes {
-        let obj = scene
-            .objects
-            .iter()
-            .find(|o| &o.name == name)
-            .ok_or_else(|| {
-                Error::Usage(format!(
-                    "--size names {name:?}, which is not an object of {} (objects: {})",
-                    scene.source.display(),
-                    scene
-                        .objects
-                        .iter()
-                        .map(|o| o.name.as_str())
-                        .collect::<Vec<_>>()
-                        .join(", ")
-                ))
-            })?;
+        let obj = find("--size", name)?;
         if !(metres.is_finite() && metres > 0.0) {
             return Err(Error::Usage(format!(
                 "--size {name}={metres}: size must be positive"
@@ -125,7 +171,7 @@ pub fn prepare(scene: &Scene, opts: &PrepareOptions) -> Result<PreparedScene> {
             visual,
             geometry,
             to_world,
-            physical: o.physical.clone(),
+            physical: physical[o.name.as_str()].clone(),
             closed,
             warnings: w,
         });
@@ -145,6 +191,22 @@ pub fn prepare(scene: &Scene, opts: &PrepareOptions) -> Result<PreparedScene> {
         warnings.push(format!(
             "scene is huge ({diag:.3e} m across): check its units or pass --size"
         ));
+    }
+    if let ([o], None) = (objects.as_slice(), size_scale) {
+        let (lo, hi) = LONE_OBJECT_METRES;
+        let long = o.geometry.aabb().map(|b| b.extents().max()).unwrap_or(0.0);
+        if !(lo..=hi).contains(&long) {
+            warnings.push(format!(
+                "{} is {} long, read as metres: if that is not its real size, pass --size {}=METRES (its longest extent)",
+                o.name,
+                if long >= 0.1 {
+                    format!("{long:.3} m")
+                } else {
+                    format!("{:.3} mm", long * 1e3)
+                },
+                o.name
+            ));
+        }
     }
     if !opts.keep_height {
         let shift = V3::new(0.0, 0.0, -bounds.min.z);

@@ -1,5 +1,8 @@
 //! `report.json`: what export computed for each object, and the validation verdict.
 //! Field names and order are part of the documented schema (README).
+//!
+//! Entry points: [`Report::new`], [`Report::warning_lines`] (what `export` and `validate` print
+//! under their table).
 
 use crate::body::Assembly;
 use crate::export::format::round;
@@ -51,6 +54,25 @@ pub struct ObjectReport {
 }
 
 impl Report {
+    /// Every warning of the report and of `validation`, one line each, in a fixed order: the
+    /// scene's, then each object's (prefixed with its name), then the validation's. Repeats are
+    /// listed once.
+    pub fn warning_lines(&self, validation: Option<&crate::validate::Validation>) -> Vec<String> {
+        let mut lines: Vec<String> = self.warnings.clone();
+        for o in &self.objects {
+            lines.extend(o.warnings.iter().map(|w| format!("{}: {w}", o.name)));
+        }
+        if let Some(v) = validation {
+            lines.extend(v.warnings.iter().cloned());
+        }
+        let mut seen = std::collections::BTreeSet::new();
+        lines
+            .into_iter()
+            .map(|l| l.replace(['\n', '\r'], " "))
+            .filter(|l| seen.insert(l.clone()))
+            .collect()
+    }
+
     /// The report of an assembly (no validation yet).
     pub fn new(a: &Assembly) -> Report {
         let objects = a

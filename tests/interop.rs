@@ -148,6 +148,9 @@ fn check_engines(scene: &Path, extra: &[&str]) {
 
 #[test]
 fn fixtures_load_in_mujoco_and_pybullet() {
+    if !python_or_skip("interop::fixtures_load_in_mujoco_and_pybullet") {
+        return;
+    }
     let fx = fixtures();
     assert!(fx.len() >= 4, "fixtures/ must hold the generated scenes");
     for f in fx {
@@ -157,11 +160,11 @@ fn fixtures_load_in_mujoco_and_pybullet() {
 
 #[test]
 fn shared_scenes_load_in_mujoco_and_pybullet() {
-    let scenes = shared_scenes();
-    if !shared().exists() {
-        eprintln!("../shared not present: skipped");
+    const TEST: &str = "interop::shared_scenes_load_in_mujoco_and_pybullet";
+    if shared_or_skip(TEST, "datasets/scenes").is_none() || !python_or_skip(TEST) {
         return;
     }
+    let scenes = shared_scenes();
     assert!(scenes.len() >= 10);
     for s in scenes {
         check_engines(&s, &[]);
@@ -170,9 +173,11 @@ fn shared_scenes_load_in_mujoco_and_pybullet() {
 
 #[test]
 fn real_scans_load_in_mujoco_and_pybullet() {
-    let base = shared().join("datasets/objects");
-    if !base.exists() {
-        eprintln!("../shared not present: skipped");
+    const TEST: &str = "interop::real_scans_load_in_mujoco_and_pybullet";
+    let Some(base) = shared_or_skip(TEST, "datasets/objects") else {
+        return;
+    };
+    if !python_or_skip(TEST) {
         return;
     }
     for (mesh, extra) in [
@@ -189,4 +194,96 @@ fn real_scans_load_in_mujoco_and_pybullet() {
     ] {
         check_engines(&base.join(mesh), extra);
     }
+}
+
+/// A quaternion from four JSON numbers in the order given (`wxyz` true: scalar first).
+fn quat(v: &serde_json::Value, wxyz: bool) -> nalgebra::UnitQuaternion<f64> {
+    let a: Vec<f64> = v
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|x| x.as_f64().unwrap())
+        .collect();
+    let q = if wxyz {
+        nalgebra::Quaternion::new(a[0], a[1], a[2], a[3])
+    } else {
+        nalgebra::Quaternion::new(a[3], a[0], a[1], a[2])
+    };
+    nalgebra::UnitQuaternion::from_quaternion(q)
+}
+
+fn vec3(v: &serde_json::Value) -> nalgebra::Vector3<f64> {
+    let a: Vec<f64> = v
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|x| x.as_f64().unwrap())
+        .collect();
+    nalgebra::Vector3::new(a[0], a[1], a[2])
+}
+
+/// docs/viewing.md's PyBullet recipe (each URDF loaded at scene.json's `translation` and
+/// `quaternion_xyzw`, passed as they are) puts every body exactly where MuJoCo puts it from
+/// scene.xml; the pose comment in each URDF says the same pose (its rpy too, by URDF's
+/// fixed-axis convention); scene.json's two quaternion orders are the same rotation. Settled
+/// poses, so the rotations are not all the identity. Reading wxyz as xyzw would be off by far
+/// more than the tolerance (checked too, so the comparison can fail). PyBullet's link frame is
+/// compared (its base pose is at the inertia's principal axes; check_view.py undoes that).
+#[test]
+fn viewing_recipes_place_every_body_where_mujoco_does() {
+    if !python_or_skip("interop::viewing_recipes_place_every_body_where_mujoco_does") {
+        return;
+    }
+    let (mut worst_pos, mut worst_angle, mut bodies) = (0.0f64, 0.0f64, 0);
+    for fixture in ["ball_bowl", "pen_mug", "fruit_basket"] {
+        let tmp = tempfile::tempdir().unwrap();
+        let out = tmp.path().join("out");
+        export(&root().join("fixtures").join(fixture), &out, &[]);
+        let view = python_json("check_view.py", &[out.to_str().unwrap()]);
+        for (name, v) in view.as_object().unwrap() {
+            bodies += 1;
+            let mj_pos = vec3(&v["mujoco"]["xpos"]);
+            let mj_q = quat(&v["mujoco"]["xquat_wxyz"], true);
+            let pb_pos = vec3(&v["pybullet"]["position"]);
+            let pb_q = quat(&v["pybullet"]["orientation_xyzw"], false);
+            worst_pos = worst_pos.max((mj_pos - pb_pos).norm());
+            worst_angle = worst_angle.max(mj_q.angle_to(&pb_q));
+            // The wrong order is detected: scene.json's wxyz read as xyzw.
+            let wrong = quat(&v["scene_json"]["quaternion_wxyz"], false);
+            assert!(
+                mj_q.angle_to(&wrong) > 0.1,
+                "{fixture}/{name}: the order test cannot fail"
+            );
+            // scene.json: both orders the same rotation, the same as MuJoCo's.
+            let sj_wxyz = quat(&v["scene_json"]["quaternion_wxyz"], true);
+            let sj_xyzw = quat(&v["scene_json"]["quaternion_xyzw"], false);
+            assert!(sj_wxyz.angle_to(&sj_xyzw) < 1e-12, "{fixture}/{name}");
+            assert!(sj_wxyz.angle_to(&mj_q) < 1e-8, "{fixture}/{name}");
+            // The URDF's comment: the same pose, rpy included.
+            let c = &v["urdf_comment"];
+            assert!(
+                c.is_object(),
+                "{fixture}/{name}: no pose comment in the URDF"
+            );
+            assert!(
+                (vec3(&c["xyz"]) - mj_pos).norm() < 1e-8,
+                "{fixture}/{name}: {c}"
+            );
+            assert!(
+                quat(&c["quaternion_xyzw"], false).angle_to(&mj_q) < 1e-8,
+                "{fixture}/{name}: {c}"
+            );
+            let rpy = vec3(&c["rpy"]);
+            let from_rpy = nalgebra::UnitQuaternion::from_euler_angles(rpy.x, rpy.y, rpy.z);
+            assert!(from_rpy.angle_to(&mj_q) < 1e-8, "{fixture}/{name}: {c}");
+        }
+    }
+    eprintln!(
+        "{bodies} bodies: PyBullet vs MuJoCo worst position {worst_pos:.2e} m, worst angle {worst_angle:.2e} rad"
+    );
+    assert!(bodies >= 8);
+    // PyBullet's own round trip through the inertia's principal axes (it diagonalises the
+    // tensor iteratively) costs ~1e-7 rad; the wrong quaternion order is 0.1 rad and more off.
+    assert!(worst_pos < 1e-7, "{worst_pos}");
+    assert!(worst_angle < 1e-5, "{worst_angle}");
 }

@@ -234,6 +234,9 @@ pub fn compose_folder(
         registration_json(&sample, &comp, &check, o),
     );
     let labels = meta.get("analysis").cloned();
+    // The same names `export` gives the sample folder itself (labels, ids as aliases).
+    let ids: Vec<String> = sample.inputs.iter().map(|i| i.name.clone()).collect();
+    let shown = crate::scene::sample::object_names(&Value::Object(meta.clone()), &ids);
     let manifest = Manifest {
         format: crate::scene::manifest::FORMAT.into(),
         version: 1,
@@ -246,10 +249,11 @@ pub fn compose_folder(
         objects: sample
             .inputs
             .iter()
-            .filter_map(|i| {
+            .zip(&shown)
+            .filter_map(|(i, shown)| {
                 let r = comp.get(&i.name)?;
                 Some(ManifestObject {
-                    name: i.name.clone(),
+                    name: shown.clone(),
                     mesh: format!("{}.glb", i.name),
                     label: labels
                         .as_ref()

@@ -110,7 +110,9 @@ pub fn load_truth(dir: &Path) -> Result<Vec<TruthObject>> {
         .objects
         .into_iter()
         .map(|o| TruthObject {
-            name: o.name,
+            // The file's id (`object_b`), not the label-derived name: guidance parts are
+            // `guidance_<id>.glb`.
+            name: o.aliases.into_iter().next().unwrap_or(o.name),
             visual: o.visual,
             pose: o.pose,
         })

@@ -139,6 +139,11 @@ struct BodyCtx {
     hulls: Vec<MeshCtx>,
     urdf_visual: String,
     urdf_rgba: String,
+    /// The body's initial world pose (as in scene.json), for the URDF's comment: position,
+    /// quaternion scalar last, and URDF's roll-pitch-yaw.
+    pose_xyz: String,
+    quat_xyzw: String,
+    pose_rpy: String,
 }
 
 fn body_context(b: &Body, files: files::BodyFiles) -> BodyCtx {
@@ -203,6 +208,12 @@ fn body_context(b: &Body, files: files::BodyFiles) -> BodyCtx {
             .collect(),
         urdf_visual: format!("meshes/{}", files.visual_all),
         urdf_rgba,
+        pose_xyz: vec3(&b.pose.translation.vector),
+        quat_xyzw: format!("{} {} {} {}", f(q.i), f(q.j), f(q.k), f(q.w)),
+        pose_rpy: {
+            let (r, p, y) = b.pose.rotation.euler_angles();
+            format!("{} {} {}", f(r), f(p), f(y))
+        },
     }
 }
 

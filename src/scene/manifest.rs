@@ -103,7 +103,10 @@ pub struct ManifestObject {
     pub inertial: Option<InertialSpec>,
 }
 
-/// A pose: a 4x4 matrix, or translation + quaternion (w, x, y, z) + uniform scale.
+/// A pose: a 4x4 matrix, or translation + quaternion + uniform scale. The quaternion may be
+/// given in either order, `quaternion_wxyz` (MuJoCo's, scalar first) or `quaternion_xyzw`
+/// (PyBullet's and ROS's, scalar last); export writes both, and when both are given they must
+/// be the same rotation. Neither: the identity.
 #[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
 #[serde(untagged, deny_unknown_fields)]
 pub enum PoseSpec {
@@ -113,8 +116,10 @@ pub enum PoseSpec {
     Parts {
         #[serde(default = "zero3")]
         translation: [f64; 3],
-        #[serde(default = "unit_quat")]
-        quaternion_wxyz: [f64; 4],
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        quaternion_wxyz: Option<[f64; 4]>,
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        quaternion_xyzw: Option<[f64; 4]>,
         #[serde(default = "one")]
         scale: f64,
     },
@@ -122,9 +127,6 @@ pub enum PoseSpec {
 
 fn zero3() -> [f64; 3] {
     [0.0; 3]
-}
-fn unit_quat() -> [f64; 4] {
-    [1.0, 0.0, 0.0, 0.0]
 }
 fn one() -> f64 {
     1.0
@@ -137,16 +139,40 @@ impl PoseSpec {
             PoseSpec::Parts {
                 translation,
                 quaternion_wxyz,
+                quaternion_xyzw,
                 scale,
-            } => Similarity::from_parts(*translation, *quaternion_wxyz, *scale),
+            } => {
+                let from_xyzw = quaternion_xyzw.map(|[x, y, z, w]| [w, x, y, z]);
+                let q = match (quaternion_wxyz, from_xyzw) {
+                    (Some(a), Some(b)) => {
+                        let (sa, sb) = (
+                            Similarity::from_parts(*translation, *a, *scale)?,
+                            Similarity::from_parts(*translation, b, *scale)?,
+                        );
+                        if sa.rotation.angle_to(&sb.rotation) > 1e-6 {
+                            return Err(format!(
+                                "quaternion_wxyz {a:?} and quaternion_xyzw {:?} are different rotations (xyzw is the same four numbers with w last)",
+                                quaternion_xyzw.unwrap_or_default()
+                            ));
+                        }
+                        *a
+                    }
+                    (Some(a), None) => *a,
+                    (None, Some(b)) => b,
+                    (None, None) => [1.0, 0.0, 0.0, 0.0],
+                };
+                Similarity::from_parts(*translation, q, *scale)
+            }
         }
     }
 
+    /// The pose as parts, its quaternion in both orders.
     pub fn from_similarity(s: &Similarity) -> PoseSpec {
         let q = s.rotation.quaternion();
         PoseSpec::Parts {
             translation: [s.translation.x, s.translation.y, s.translation.z],
-            quaternion_wxyz: [q.w, q.i, q.j, q.k],
+            quaternion_wxyz: Some([q.w, q.i, q.j, q.k]),
+            quaternion_xyzw: Some([q.i, q.j, q.k, q.w]),
             scale: s.scale,
         }
     }
@@ -232,8 +258,15 @@ pub fn load(path: &Path, limits: &Limits) -> Result<Scene> {
         };
         let mesh_path = resolve_inside(&root, path, &o.mesh)?;
         let visual = crate::io::load_visual(&mesh_path, limits)?;
+        // The mesh file's stem as an alias (a composed sample's `object_b.glb` stays
+        // `object_b` on the command line when the object is called `lemon`).
+        let stem = Path::new(&o.mesh)
+            .file_stem()
+            .map(|s| s.to_string_lossy().into_owned())
+            .filter(|s| super::is_valid_name(s) && s != &o.name);
         objects.push(SceneObject {
             name: o.name.clone(),
+            aliases: stem.into_iter().collect(),
             label: o.label.clone(),
             mesh_path,
             visual,
@@ -246,6 +279,7 @@ pub fn load(path: &Path, limits: &Limits) -> Result<Scene> {
             },
         });
     }
+    super::drop_ambiguous_aliases(&mut objects);
     let name = m.name.clone().unwrap_or_else(|| {
         root.canonicalize()
             .ok()

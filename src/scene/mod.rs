@@ -1,6 +1,9 @@
 //! Scenes as they come in: an Interact3D sample folder or our own `scene.json` manifest, each
 //! loaded into the same [`Scene`]: named objects, each a visual mesh in its own frame plus the
 //! similarity that places it in the scene.
+//!
+//! Entry points: [`load`], [`single_mesh`], [`Scene::find`] (by name or alias), [`sanitize_name`],
+//! [`is_valid_name`]; the formats in [`sample`] and [`manifest`].
 
 pub mod manifest;
 pub mod sample;
@@ -34,8 +37,12 @@ pub struct Physical {
 /// One object of a scene.
 #[derive(Clone, Debug)]
 pub struct SceneObject {
-    /// Identifier, unique in the scene: `[A-Za-z_][A-Za-z0-9_-]*`.
+    /// Identifier, unique in the scene: `[A-Za-z_][A-Za-z0-9_-]*`. Output files are named by it.
     pub name: String,
+    /// Other names the command line may use for it (`--size`, `--density`, `--mass`): a sample's
+    /// `object_b` when it is named from its label, a manifest object's mesh file stem. Never
+    /// another object's name or alias.
+    pub aliases: Vec<String>,
     /// Human label (e.g. "bowl") when the input has one.
     pub label: Option<String>,
     /// The mesh file it was read from.
@@ -60,6 +67,66 @@ pub struct Scene {
     pub objects: Vec<SceneObject>,
     /// Notes from loading that do not stop it.
     pub warnings: Vec<String>,
+}
+
+impl Scene {
+    /// The object `name` designates: its name, else one of its aliases.
+    pub fn find(&self, name: &str) -> Option<&SceneObject> {
+        self.objects.iter().find(|o| o.name == name).or_else(|| {
+            self.objects
+                .iter()
+                .find(|o| o.aliases.iter().any(|a| a == name))
+        })
+    }
+
+    /// The objects' names, each with its aliases in brackets (`lemon (object_b)`), for messages.
+    pub fn names_listed(&self) -> String {
+        self.objects
+            .iter()
+            .map(|o| {
+                if o.aliases.is_empty() {
+                    o.name.clone()
+                } else {
+                    format!("{} ({})", o.name, o.aliases.join(", "))
+                }
+            })
+            .collect::<Vec<_>>()
+            .join(", ")
+    }
+
+    /// Whether the format fixes the up axis: glTF is Y-up by its specification, so a sample
+    /// folder or a lone `.glb`/`.gltf` file takes no `--up`. The reason, when it does.
+    pub fn up_axis_fixed(&self) -> Option<&'static str> {
+        let src = &self.source;
+        let ext = src
+            .extension()
+            .and_then(|e| e.to_str())
+            .map(str::to_ascii_lowercase);
+        let sample = if src.is_dir() {
+            !src.join("scene.json").is_file()
+        } else {
+            src.file_name().is_some_and(|n| n == "metadata.json")
+        };
+        if sample {
+            Some("an Interact3D sample folder holds glTF, which is Y-up by its specification")
+        } else if matches!(ext.as_deref(), Some("glb" | "gltf")) {
+            Some("glTF is Y-up by its specification")
+        } else {
+            None
+        }
+    }
+}
+
+/// Drop every alias that is another object's name or that several objects share, so an alias
+/// designates one object or none.
+pub(crate) fn drop_ambiguous_aliases(objects: &mut [SceneObject]) {
+    let names: Vec<String> = objects.iter().map(|o| o.name.clone()).collect();
+    let all: Vec<String> = objects.iter().flat_map(|o| o.aliases.clone()).collect();
+    for o in objects.iter_mut() {
+        o.aliases.retain(|a| {
+            a != &o.name && !names.contains(a) && all.iter().filter(|x| *x == a).count() == 1
+        });
+    }
 }
 
 /// Load a scene from a sample folder (with `metadata.json`), a folder with `scene.json`, or a
@@ -128,6 +195,7 @@ pub fn single_mesh(path: &Path, limits: &Limits) -> Result<Scene> {
         },
         objects: vec![SceneObject {
             name,
+            aliases: Vec::new(),
             label: None,
             mesh_path: path.to_path_buf(),
             visual,

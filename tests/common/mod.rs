@@ -58,6 +58,108 @@ pub fn python() -> String {
     std::env::var("INTERACT3D_PYTHON").unwrap_or_else(|_| "python3".into())
 }
 
+/// A prerequisite a test may lack on a user's machine.
+#[derive(Clone, Copy, PartialEq, Eq, Debug)]
+pub enum Prereq {
+    /// `../shared` (the project's shared datasets, beside the repository).
+    Shared,
+    /// A Python interpreter with the packages of tests/python/requirements.txt.
+    Python,
+}
+
+impl Prereq {
+    fn key(self) -> &'static str {
+        match self {
+            Prereq::Shared => "shared",
+            Prereq::Python => "python",
+        }
+    }
+}
+
+/// Whether a missing `what` must fail the test rather than skip it: always under CI
+/// (`CI=true`), and for each kind listed in `INTERACT3D_REQUIRE` (`.ci/test` lists `python`,
+/// since it installed the packages itself).
+pub fn required(what: Prereq) -> bool {
+    std::env::var("CI").is_ok_and(|v| v == "true")
+        || std::env::var("INTERACT3D_REQUIRE")
+            .is_ok_and(|v| v.split(',').any(|k| k.trim() == what.key()))
+}
+
+/// A check that cannot run here: fails the test when `what` is required (see [`required`]);
+/// else says so loudly — one `SKIPPED` line written straight to the process's stderr, which
+/// the test harness does not capture, so it shows in a plain `cargo test` — and appends the
+/// line to `$INTERACT3D_SKIP_LOG` (`.ci/test` lists them all at the end).
+pub fn skip(test: &str, what: Prereq, reason: &str) {
+    let line = format!("{test}: {reason}");
+    if required(what) {
+        panic!(
+            "{line} (a required prerequisite: CI=true or INTERACT3D_REQUIRE={})",
+            what.key()
+        );
+    }
+    use std::io::Write;
+    let _ = writeln!(std::io::stderr().lock(), "SKIPPED {line}");
+    if let Ok(log) = std::env::var("INTERACT3D_SKIP_LOG") {
+        if let Ok(mut f) = fs::OpenOptions::new().create(true).append(true).open(log) {
+            let _ = writeln!(f, "{line}");
+        }
+    }
+}
+
+/// `../shared/<rel>` when it exists; else [`skip`]s `test` and gives `None`.
+pub fn shared_or_skip(test: &str, rel: &str) -> Option<PathBuf> {
+    let p = shared().join(rel);
+    if p.exists() {
+        return Some(p);
+    }
+    skip(
+        test,
+        Prereq::Shared,
+        &format!(
+            "{} not found (the project's shared datasets belong beside the repository as ../shared)",
+            p.display()
+        ),
+    );
+    None
+}
+
+/// Why [`python()`] cannot run the engine checks (cannot start, or lacks a package), or
+/// `None` when it can. Asked once per test binary.
+pub fn python_problem() -> Option<String> {
+    static PROBLEM: std::sync::OnceLock<Option<String>> = std::sync::OnceLock::new();
+    PROBLEM
+        .get_or_init(|| {
+            let py = python();
+            match Command::new(&py)
+                .args(["-c", "import mujoco, pybullet, numpy"])
+                .output()
+            {
+                Err(e) => Some(format!("cannot run Python {py:?} ({e})")),
+                Ok(o) if !o.status.success() => Some(format!(
+                    "Python {py:?} lacks a package of tests/python/requirements.txt ({}); run .ci/test, which makes its own venv, or point INTERACT3D_PYTHON at a Python that has them",
+                    String::from_utf8_lossy(&o.stderr)
+                        .lines()
+                        .last()
+                        .unwrap_or("import failed")
+                        .trim()
+                )),
+                Ok(_) => None,
+            }
+        })
+        .clone()
+}
+
+/// Whether the Python engine checks can run; if not, [`skip`]s `test` with the reason.
+pub fn python_or_skip(test: &str) -> bool {
+    match python_problem() {
+        None => true,
+        Some(why) => {
+            skip(test, Prereq::Python, &why);
+            false
+        }
+    }
+}
+
 /// Run one of tests/python/*.py and parse its JSON output.
 pub fn python_json(script: &str, args: &[&str]) -> serde_json::Value {
     let out = Command::new(python())
