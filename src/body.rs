@@ -116,13 +116,28 @@ pub fn assemble(
     source: &std::path::Path,
 ) -> Result<Assembly> {
     let meshes: Vec<&Mesh> = prepared.objects.iter().map(|o| &o.geometry).collect();
-    let hull_sets = engine.decompose(&meshes, dopts)?;
+    let mut hull_sets = engine.decompose(&meshes, dopts)?;
+    let legal = crate::decompose::physx_legal(&mut hull_sets, dopts);
     let notes = engine.object_warnings();
     let mut bodies = Vec::with_capacity(prepared.objects.len());
     for (k, (o, hulls)) in prepared.objects.iter().zip(hull_sets).enumerate() {
         let density = o.physical.density.unwrap_or(DEFAULT_DENSITY);
         let mut warnings = o.warnings.clone();
         warnings.extend(notes.get(k).into_iter().flatten().cloned());
+        let l = legal[k];
+        if l.dropped > 0 {
+            warnings.push(format!(
+                "{} sliver hull(s) dropped (extent/inner radius over {}: PhysX keeps them off the GPU)",
+                l.dropped,
+                crate::decompose::MAX_SLIVER_RATIO
+            ));
+        }
+        if l.over > 0 {
+            warnings.push(format!(
+                "{} hull(s) could not be brought within {} vertices and {} polygons: PhysX will re-cook them",
+                l.over, dopts.max_vertices, dopts.max_polygons
+            ));
+        }
         let smallest = o.geometry.aabb().map(|b| b.extents().min()).unwrap_or(0.0);
         if hulls.is_empty() && smallest > 0.0 && smallest < dopts.min_thickness {
             return Err(Error::input(

@@ -169,6 +169,10 @@ struct BuildArgs {
     /// Most vertices per hull (PhysX/Isaac accept 64).
     #[arg(long, default_value_t = 64)]
     max_hull_vertices: usize,
+    /// Most polygons per hull (coplanar triangles merged). PhysX cooks a hull of more than 64
+    /// into another shape, silently; 0: no limit (MuJoCo-only exports keep rounder hulls).
+    #[arg(long, value_name = "N", default_value_t = interact3d::decompose::DEFAULT_MAX_POLYGONS)]
+    max_hull_polygons: usize,
     /// V-HACD voxel resolution.
     #[arg(long, default_value_t = 64)]
     vhacd_resolution: u32,
@@ -328,6 +332,10 @@ impl BuildArgs {
         o.engine = self.engine;
         o.decompose.max_hulls = self.max_hulls;
         o.decompose.max_vertices = self.max_hull_vertices;
+        o.decompose.max_polygons = match self.max_hull_polygons {
+            0 => usize::MAX,
+            n => n,
+        };
         o.decompose.resolution = self.vhacd_resolution;
         o.decompose.cache_dir = self.decompose_cache.clone();
         o

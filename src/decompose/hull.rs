@@ -13,6 +13,27 @@ pub struct Hull {
     pub aabb: Aabb,
 }
 
+/// What PhysX cooks a convex mesh as written, and keeps on the GPU: at most 64 vertices, 64
+/// polygons (coplanar triangles merged) and 32 vertices on one polygon, and not a sliver. A hull
+/// over these is re-cooked silently into another shape (measured with ovphysx 0.7: a 64-vertex
+/// round hull, about 124 triangles, came back as 34 of its vertices, some 8 mm inside).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PhysxLimits {
+    pub max_vertices: usize,
+    pub max_polygons: usize,
+    pub max_polygon_vertices: usize,
+}
+
+impl Default for PhysxLimits {
+    fn default() -> Self {
+        PhysxLimits {
+            max_vertices: 64,
+            max_polygons: 64,
+            max_polygon_vertices: 32,
+        }
+    }
+}
+
 impl Hull {
     /// The convex hull of a point set; `None` when degenerate (fewer than 4 points in general
     /// position, or zero volume).
@@ -146,18 +167,98 @@ impl Hull {
         Hull::from_points(&sub)
     }
 
+    /// The hull's polygons: its triangles merged by plane (normals within 1e-6 rad², offsets
+    /// within 1e-7 of the diagonal), each as its distinct vertex indices. This is the face count
+    /// PhysX's cooking limits (64 for the GPU), and it errs high: PhysX merges near-coplanar
+    /// triangles with a looser tolerance, never a stricter one.
+    pub fn polygons(&self) -> Vec<Vec<usize>> {
+        self.facets().into_iter().map(|f| f.3).collect()
+    }
+
+    /// `(polygons, most vertices on one polygon)`.
+    pub fn polygon_stats(&self) -> (usize, usize) {
+        let p = self.polygons();
+        (p.len(), p.iter().map(Vec::len).max().unwrap_or(0))
+    }
+
+    /// How much of a sliver the hull is: the largest half-extent of its box over its inner
+    /// radius (the distance from its vertex centroid to the nearest face plane). PhysX keeps a
+    /// convex mesh off the GPU when its extent/radius ratio is too large (it checks its own
+    /// internal box, which is smaller than this one, so this errs high).
+    pub fn sliver_ratio(&self) -> f64 {
+        let n = self.vertices.len().max(1) as f64;
+        let c = self.vertices.iter().fold(V3::zeros(), |a, v| a + v.coords) / n;
+        let r = self
+            .planes
+            .iter()
+            .map(|(nrm, d)| d - nrm.dot(&c))
+            .fold(f64::INFINITY, f64::min);
+        let half = 0.5 * self.aabb.extents().max();
+        if r > 0.0 {
+            half / r
+        } else {
+            f64::INFINITY
+        }
+    }
+
+    /// The hull brought within PhysX's cooking limits (see [`PhysxLimits`]): at most
+    /// `max_vertices` vertices, `max_polygons` polygons and `max_polygon_vertices` vertices on one
+    /// polygon. It drops vertices the way [`Hull::simplified`] does (farthest-point sampling
+    /// from the original's extreme points, large flat faces kept), fewer each round until the
+    /// polygons fit, so the result lies inside the original and never grows into a neighbour.
+    /// `None` when no hull of 4 or more vertices fits.
+    pub fn within(self, limits: &PhysxLimits) -> Option<Hull> {
+        let fits = |h: &Hull| {
+            let (p, pv) = h.polygon_stats();
+            h.vertices.len() <= limits.max_vertices
+                && p <= limits.max_polygons
+                && pv <= limits.max_polygon_vertices
+        };
+        if fits(&self) {
+            return Some(self);
+        }
+        let mut k = self.vertices.len().min(limits.max_vertices);
+        loop {
+            let h = self.clone().simplified(k)?;
+            let (p, pv) = h.polygon_stats();
+            if h.vertices.len() <= limits.max_vertices
+                && p <= limits.max_polygons
+                && pv <= limits.max_polygon_vertices
+            {
+                return Some(h);
+            }
+            // A round hull has about 2V - 4 faces: each vertex dropped removes about two.
+            let step = if p > limits.max_polygons {
+                ((p - limits.max_polygons) / 2).max(1)
+            } else {
+                1
+            };
+            k = k.min(h.vertices.len()).checked_sub(step)?;
+            if k < 4 {
+                return None;
+            }
+        }
+    }
+
     /// Vertex sets of the planar facets (coplanar triangles merged) whose area is at least
     /// `min_fraction` of the hull's area, largest first.
     fn large_facets(&self, min_fraction: f64) -> Vec<Vec<usize>> {
+        let mut facets = self.facets();
+        let total: f64 = facets.iter().map(|f| f.2).sum();
+        facets.retain(|f| f.2 >= min_fraction * total && f.3.len() >= 3);
+        facets.sort_by(|a, b| b.2.total_cmp(&a.2));
+        facets.into_iter().map(|f| f.3).collect()
+    }
+
+    /// Triangles merged by plane: (normal, offset, area, distinct vertices), in triangle order.
+    fn facets(&self) -> Vec<(V3, f64, f64, Vec<usize>)> {
         let scale = self.aabb.diagonal().max(1e-300);
-        let mut facets: Vec<(V3, f64, f64, Vec<usize>)> = Vec::new(); // normal, offset, area, vertices
-        let mut total = 0.0;
+        let mut facets: Vec<(V3, f64, f64, Vec<usize>)> = Vec::new();
         for i in 0..self.triangles.len() {
             let t = self.triangles[i];
             let [a, b, c] = [t[0], t[1], t[2]].map(|k| self.vertices[k as usize]);
             let n = (b - a).cross(&(c - a));
             let area = 0.5 * n.norm();
-            total += area;
             if area <= 0.0 {
                 continue;
             }
@@ -180,9 +281,7 @@ impl Hull {
                 }
             }
         }
-        facets.retain(|f| f.2 >= min_fraction * total && f.3.len() >= 3);
-        facets.sort_by(|a, b| b.2.total_cmp(&a.2));
-        facets.into_iter().map(|f| f.3).collect()
+        facets
     }
 
     /// The hull as a mesh.

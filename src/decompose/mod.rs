@@ -2,20 +2,31 @@
 //! can collide. Engines sit behind [`Decomposer`], which sees the whole scene (world frame), so a
 //! scene-aware engine can keep hulls off the neighbours. Every engine's output goes through
 //! [`finish`]: at most `max_hulls` hulls per object, at most `max_vertices` vertices per hull,
-//! no degenerate or paper-thin hulls.
+//! no degenerate or paper-thin hulls. Every engine's hulls then go through [`physx_legal`]: at
+//! most `max_polygons` polygons per hull (PhysX re-cooks a hull over 64 polygons into another
+//! shape, silently), no slivers PhysX keeps off the GPU.
 
 pub mod cache;
 mod hull;
 pub mod scene_aware;
 pub mod vhacd;
 
-pub use hull::Hull;
+pub use hull::{Hull, PhysxLimits};
 
 use crate::error::Result;
 use crate::mesh::Mesh;
 
 /// The default hull budget per object (`DecomposeOptions::max_hulls`, `--max-hulls`).
 pub const DEFAULT_MAX_HULLS: usize = 32;
+
+/// The default polygon budget per hull (`DecomposeOptions::max_polygons`,
+/// `--max-hull-polygons`): PhysX's, so a hull is simulated by Isaac as it was validated here.
+pub const DEFAULT_MAX_POLYGONS: usize = 64;
+
+/// Hulls whose [`Hull::sliver_ratio`] is above this are dropped by [`physx_legal`] (unless they
+/// are all an object has): PhysX keeps a convex mesh whose extent/inner-radius ratio passes
+/// 100 off the GPU.
+pub const MAX_SLIVER_RATIO: f64 = 100.0;
 
 /// Limits every decomposition meets.
 #[derive(Clone, Debug, PartialEq)]
@@ -24,6 +35,9 @@ pub struct DecomposeOptions {
     pub max_hulls: usize,
     /// Most vertices per hull (PhysX/Isaac accept 64; MuJoCo any).
     pub max_vertices: usize,
+    /// Most polygons per hull, coplanar triangles merged (PhysX cooks at most 64 as written;
+    /// MuJoCo any). `usize::MAX`: no limit.
+    pub max_polygons: usize,
     /// Hulls thinner than this (m) are dropped: MuJoCo refuses near-flat meshes.
     pub min_thickness: f64,
     /// V-HACD voxel resolution along the longest axis.
@@ -44,6 +58,7 @@ impl Default for DecomposeOptions {
         DecomposeOptions {
             max_hulls: DEFAULT_MAX_HULLS,
             max_vertices: 64,
+            max_polygons: DEFAULT_MAX_POLYGONS,
             min_thickness: 2e-4,
             resolution: 64,
             concavity: 0.01,
@@ -126,4 +141,79 @@ fn merge_down(hulls: &mut Vec<Hull>, max: usize) {
             }
         }
     }
+}
+
+/// What [`physx_legal`] did to one object's hulls.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct LegalNote {
+    /// Hulls that lost vertices to fit.
+    pub reduced: usize,
+    /// Slivers dropped.
+    pub dropped: usize,
+    /// Hulls no reduction could fit (kept as they were: PhysX will re-cook them).
+    pub over: usize,
+}
+
+/// Bring every object's hulls within PhysX's cooking limits (`max_vertices`, `max_polygons`,
+/// 32 vertices per polygon; see [`Hull::within`]) and drop slivers (see [`MAX_SLIVER_RATIO`]),
+/// keeping an object's hulls when all of them are slivers (a thin plate must still collide).
+/// Hulls only shrink (their vertices are a subset of the input's), so a decomposition kept off
+/// its neighbours stays off them. With `max_polygons == usize::MAX` and the vertex budget met,
+/// nothing changes. Returns what was done to each object.
+pub fn physx_legal(sets: &mut [Vec<Hull>], opts: &DecomposeOptions) -> Vec<LegalNote> {
+    let limits = PhysxLimits {
+        max_vertices: opts.max_vertices,
+        max_polygons: opts.max_polygons,
+        max_polygon_vertices: if opts.max_polygons == usize::MAX {
+            usize::MAX
+        } else {
+            PhysxLimits::default().max_polygon_vertices
+        },
+    };
+    sets.iter_mut()
+        .map(|hulls| {
+            let (mut reduced, mut over) = (0, 0);
+            let mut out = Vec::with_capacity(hulls.len());
+            for h in hulls.drain(..) {
+                let before = h.vertices.len();
+                let fallback = h.clone();
+                let h = match h
+                    .within(&limits)
+                    .filter(|h| h.thickness() >= opts.min_thickness)
+                {
+                    Some(h) => h,
+                    None => {
+                        over += 1;
+                        fallback
+                    }
+                };
+                if h.vertices.len() != before {
+                    reduced += 1;
+                }
+                out.push(h);
+            }
+            let dropped = if opts.max_polygons == usize::MAX {
+                0
+            } else {
+                let keep: Vec<bool> = out
+                    .iter()
+                    .map(|h| h.sliver_ratio() <= MAX_SLIVER_RATIO)
+                    .collect();
+                if keep.iter().any(|&k| k) {
+                    let n = out.len();
+                    let mut k = keep.into_iter();
+                    out.retain(|_| k.next().unwrap());
+                    n - out.len()
+                } else {
+                    0
+                }
+            };
+            *hulls = out;
+            LegalNote {
+                reduced,
+                dropped,
+                over,
+            }
+        })
+        .collect()
 }

@@ -30,17 +30,7 @@ pub struct BodyFiles {
 pub fn write_body_meshes(b: &Body, meshes: &Path) -> Result<BodyFiles> {
     let dir = meshes.join(&b.name);
     crate::fsutil::create_dir(&dir)?;
-    // Group parts by material (same colour and texture bytes): one MJCF geom per group.
-    let mut groups: Vec<(crate::mesh::Material, Vec<&VisualPart>)> = Vec::new();
-    for p in &b.visual.parts {
-        match groups
-            .iter_mut()
-            .find(|(m, _)| same_material(m, &p.material))
-        {
-            Some((_, v)) => v.push(p),
-            None => groups.push((p.material.clone(), vec![p])),
-        }
-    }
+    let groups = material_groups(b);
     let mut textures: Vec<Texture> = Vec::new();
     let mut materials = Vec::new();
     let mut mtl = format!("# {}\n", super::GENERATOR);
@@ -121,6 +111,22 @@ pub fn write_body_meshes(b: &Body, meshes: &Path) -> Result<BodyFiles> {
         visual_all: format!("{}/visual.obj", b.name),
         hulls,
     })
+}
+
+/// The body's visual parts grouped by material (same colour and texture bytes), in first-seen
+/// order: one MJCF geom, and one entry of [`BodyFiles::materials`], per group.
+pub fn material_groups(b: &Body) -> Vec<(crate::mesh::Material, Vec<&VisualPart>)> {
+    let mut groups: Vec<(crate::mesh::Material, Vec<&VisualPart>)> = Vec::new();
+    for p in &b.visual.parts {
+        match groups
+            .iter_mut()
+            .find(|(m, _)| same_material(m, &p.material))
+        {
+            Some((_, v)) => v.push(p),
+            None => groups.push((p.material.clone(), vec![p])),
+        }
+    }
+    groups
 }
 
 fn same_material(a: &crate::mesh::Material, b: &crate::mesh::Material) -> bool {

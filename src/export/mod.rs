@@ -5,6 +5,8 @@
 //! OUT/<object>.xml             MJCF of one object (includable)
 //! OUT/<object>.urdf            URDF of one object
 //! OUT/meshes/<object>/visual.obj, visual.mtl, texture_NN.png, collision_NN.obj
+//! OUT/scene.usda               USD scene (PhysicsScene, ground, each object referenced)
+//! OUT/<object>.usda            USD of one object (one rigid body on the default prim)
 //! OUT/scene.json               the prepared scene as a manifest (re-readable)
 //! OUT/report.json              per-object mass, inertia, hulls, warnings (+ validation)
 //! ```
@@ -15,6 +17,7 @@ mod files;
 pub mod format;
 pub mod read;
 mod templates;
+pub mod usd;
 
 pub use templates::Templates;
 
@@ -29,6 +32,9 @@ use std::path::Path;
 
 /// What a tool version writes into generated files.
 pub const GENERATOR: &str = concat!("interact3d ", env!("CARGO_PKG_VERSION"));
+
+/// Friction of the floor in the scene files (MJCF and USD).
+const FLOOR_FRICTION: f64 = 1.0;
 
 /// Options of the export stage.
 #[derive(Clone, Debug, Default)]
@@ -60,17 +66,20 @@ fn write_all(
     templates: &Templates,
 ) -> Result<()> {
     let mut ctx_bodies = Vec::new();
+    let mut body_files = Vec::new();
     for b in &assembly.bodies {
         let files = files::write_body_meshes(b, &dir.join("meshes"))?;
-        ctx_bodies.push(body_context(b, files));
+        ctx_bodies.push(body_context(b, &files));
+        body_files.push(files);
     }
+    usd::write_usd(assembly, &body_files, dir, templates, FLOOR_FRICTION)?;
     let keyframes = keyframes(assembly);
     let scene_ctx = minijinja::context! {
         generator => GENERATOR,
         scene => minijinja::context! { name => assembly.name.clone() },
         bodies => ctx_bodies.clone(),
         keyframes => keyframes,
-        floor_friction => f(1.0),
+        floor_friction => f(FLOOR_FRICTION),
     };
     crate::fsutil::write(
         &dir.join("scene.xml"),
@@ -146,7 +155,7 @@ struct BodyCtx {
     pose_rpy: String,
 }
 
-fn body_context(b: &Body, files: files::BodyFiles) -> BodyCtx {
+fn body_context(b: &Body, files: &files::BodyFiles) -> BodyCtx {
     let i = &b.inertial.inertia;
     let q = b.pose.rotation.quaternion();
     let inertia = InertiaCtx {

@@ -14,6 +14,14 @@ const BUILTIN: &[(&str, &str)] = &[
         "object.urdf.j2",
         include_str!("../../templates/object.urdf.j2"),
     ),
+    (
+        "scene.usda.j2",
+        include_str!("../../templates/scene.usda.j2"),
+    ),
+    (
+        "object.usda.j2",
+        include_str!("../../templates/object.usda.j2"),
+    ),
 ];
 
 pub struct Templates {
@@ -25,10 +33,15 @@ impl Templates {
     pub fn load(dir: Option<&Path>) -> Result<Templates> {
         let mut env = minijinja::Environment::new();
         env.set_undefined_behavior(minijinja::UndefinedBehavior::Strict);
-        // Every value is escaped for XML (URDF and MJCF alike): & < > " ' only.
+        // Every value is escaped for XML (URDF and MJCF alike): & < > " ' only. USD templates'
+        // values are written as they are: the writer hands them over as USD text already
+        // (identifiers, numbers, tuples).
         env.set_auto_escape_callback(|_| minijinja::AutoEscape::None);
-        env.set_formatter(|out, _state, value| {
+        env.set_formatter(|out, state, value| {
             let s = value.to_string();
+            if state.name().ends_with(".usda.j2") {
+                return out.write_str(&s).map_err(minijinja::Error::from);
+            }
             let mut e = String::with_capacity(s.len());
             for c in s.chars() {
                 match c {

@@ -1,0 +1,243 @@
+//! USD sweep (issue #31): every fixture and every shared scene exported and held to the USD
+//! judges of `tests/python/check_usd.py` (usd-core validators, UsdPhysics' parser, PhysX through
+//! ovphysx on the CPU), then the cost of the PhysX polygon limit on every shared object.
+//!
+//! ```text
+//! cargo run --release --example usd_sweep -- [--no-scenes] [--no-objects] [--python PY]
+//! ```
+//! Table 1, per scene: hulls, most vertices and most polygons on one hull, PhysX's largest
+//! displacement and rotation of a dynamic body over 2 s from the shipped pose, the farthest an
+//! authored hull vertex is from PhysX's cooked hulls (and back), and the validation verdict.
+//! Table 2, per shared object (scene-aware engine alone, default budget): the surface distance
+//! p95 (% of the bounding-box diagonal, `decompose::scene_aware::metrics`) of its hulls before
+//! and after `decompose::physx_legal` (64 polygons), how many hulls it changed, and its time.
+//! Needs `pip install -r tests/python/requirements-usd.txt` for table 1.
+
+use interact3d::decompose::scene_aware::{metrics, SceneAware};
+use interact3d::decompose::{physx_legal, DecomposeOptions, Decomposer, Hull};
+use interact3d::mesh::P3;
+use std::path::{Path, PathBuf};
+use std::process::Command;
+use std::time::Instant;
+
+fn root() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+}
+
+fn shared() -> PathBuf {
+    root().join("../shared")
+}
+
+fn scenes() -> Vec<PathBuf> {
+    let mut v: Vec<PathBuf> = std::fs::read_dir(root().join("fixtures"))
+        .into_iter()
+        .flatten()
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| p.join("metadata.json").is_file() || p.join("scene.json").is_file())
+        .collect();
+    v.sort();
+    let mut s = Vec::new();
+    for c in std::fs::read_dir(shared().join("datasets/scenes"))
+        .into_iter()
+        .flatten()
+    {
+        for e in std::fs::read_dir(c.unwrap().path()).into_iter().flatten() {
+            let p = e.unwrap().path();
+            if p.join("metadata.json").is_file() {
+                s.push(p);
+            }
+        }
+    }
+    s.sort();
+    v.extend(s);
+    v
+}
+
+fn pct(v: &[f64], q: f64) -> f64 {
+    let mut s = v.to_vec();
+    s.sort_by(f64::total_cmp);
+    if s.is_empty() {
+        return f64::NAN;
+    }
+    s[((s.len() - 1) as f64 * q).round() as usize]
+}
+
+fn sweep_scenes(python: &str) {
+    println!("| scene | pass | objects | hulls | max verts/hull | max polygons/hull | PhysX max moved (mm) | PhysX max turned (°) | cooked vs authored (mm) | export s | judges s |");
+    println!("|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|");
+    let (mut moved_all, mut turned_all) = (Vec::new(), Vec::new());
+    let mut worst_cook: f64 = 0.0;
+    let mut failures = 0;
+    for scene in scenes() {
+        let name = scene.file_name().unwrap().to_string_lossy().to_string();
+        let tmp = tempfile::tempdir().unwrap();
+        let out = tmp.path().join("out");
+        let t = Instant::now();
+        let job = interact3d::pipeline::ExportJob {
+            validate: Some(Default::default()),
+            ..Default::default()
+        };
+        let exported = match interact3d::pipeline::export_scene(&scene, &out, &job) {
+            Ok(e) => e,
+            Err(e) => {
+                println!("| {name} | export failed: {e} |");
+                failures += 1;
+                continue;
+            }
+        };
+        let t_export = t.elapsed().as_secs_f64();
+        let passed = exported.validation.as_ref().is_some_and(|v| v.passed);
+        let a = interact3d::export::read::load(&out, &Default::default()).unwrap();
+        let hulls: Vec<&Hull> = a.bodies.iter().flat_map(|b| &b.hulls).collect();
+        let max_v = hulls.iter().map(|h| h.vertices.len()).max().unwrap_or(0);
+        let max_p = hulls.iter().map(|h| h.polygon_stats().0).max().unwrap_or(0);
+        let t = Instant::now();
+        let o = Command::new(python)
+            .arg(root().join("tests/python/check_usd.py"))
+            .arg(&out)
+            .output()
+            .expect("run python");
+        let t_judge = t.elapsed().as_secs_f64();
+        if !o.status.success() {
+            println!(
+                "| {name} | check_usd.py failed: {} |",
+                String::from_utf8_lossy(&o.stderr)
+                    .lines()
+                    .last()
+                    .unwrap_or("")
+            );
+            failures += 1;
+            continue;
+        }
+        let u: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+        let errors: usize = u["files"]
+            .as_object()
+            .unwrap()
+            .values()
+            .map(|f| f["errors"].as_array().unwrap().len())
+            .sum();
+        let (mut moved, mut turned) = (0.0f64, 0.0f64);
+        for b in u["physx"]["bodies"].as_object().unwrap().values() {
+            moved = moved.max(b["moved_m"].as_f64().unwrap());
+            turned = turned.max(b["turned_deg"].as_f64().unwrap());
+        }
+        let c = &u["physx"]["cooked"];
+        let cook = c["authored_to_cooked_max_m"]
+            .as_f64()
+            .unwrap()
+            .max(c["cooked_to_authored_max_m"].as_f64().unwrap());
+        worst_cook = worst_cook.max(cook);
+        if passed {
+            moved_all.push(moved);
+            turned_all.push(turned);
+        }
+        if errors > 0 || cook > 1e-4 || (passed && (moved > 1e-3 || turned > 1.0)) {
+            failures += 1;
+        }
+        println!(
+            "| {name} | {} | {} | {} | {max_v} | {max_p} | {:.3} | {:.3} | {:.4} | {t_export:.1} | {t_judge:.1} |{}",
+            if passed { "yes" } else { "no" },
+            a.bodies.len(),
+            hulls.len(),
+            moved * 1e3,
+            turned,
+            cook * 1e3,
+            if errors > 0 { format!(" {errors} validator errors") } else { String::new() }
+        );
+    }
+    let mean = |v: &[f64]| v.iter().sum::<f64>() / v.len().max(1) as f64;
+    println!(
+        "\nPassing scenes: PhysX max moved mean {:.3} mm, worst {:.3} mm; max turned mean {:.3}°, worst {:.3}°; cooked hulls within {:.4} mm of the authored ones. Scenes failing a judge: {failures}.\n",
+        mean(&moved_all) * 1e3,
+        moved_all.iter().cloned().fold(0.0, f64::max) * 1e3,
+        mean(&turned_all),
+        turned_all.iter().cloned().fold(0.0, f64::max),
+        worst_cook * 1e3
+    );
+}
+
+fn sweep_objects() {
+    let index: serde_json::Value = serde_json::from_str(
+        &std::fs::read_to_string(shared().join("datasets/objects/index.json")).unwrap(),
+    )
+    .unwrap();
+    println!("| object | hulls | hulls over 64 polygons | max polygons before | p95 before (%) | p95 after (%) | cost (pp) | legal ms |");
+    println!("|---|---:|---:|---:|---:|---:|---:|---:|");
+    let (mut costs, mut times) = (Vec::new(), Vec::new());
+    let (mut hulls_total, mut hulls_over) = (0, 0);
+    for o in index.as_array().unwrap() {
+        let id = o["id"].as_str().unwrap();
+        let mut scale = o["scale_to_m"].as_f64().unwrap_or(1.0);
+        if id.contains("tray") {
+            scale *= 0.5;
+        }
+        let path = shared()
+            .join("datasets/objects")
+            .join(o["mesh"].as_str().unwrap());
+        let Ok(v) = interact3d::io::load_visual(&path, &Default::default()) else {
+            println!("| {id} | unreadable |");
+            continue;
+        };
+        let mut m = v.geometry();
+        for p in &mut m.vertices {
+            *p = P3::from(p.coords * scale);
+        }
+        let opts = DecomposeOptions {
+            max_polygons: usize::MAX,
+            ..Default::default()
+        };
+        let Ok(mut sets) = SceneAware::new().decompose(&[&m], &opts) else {
+            println!("| {id} | decomposition failed |");
+            continue;
+        };
+        let before = sets[0].clone();
+        let over = before.iter().filter(|h| h.polygon_stats().0 > 64).count();
+        let max_p = before
+            .iter()
+            .map(|h| h.polygon_stats().0)
+            .max()
+            .unwrap_or(0);
+        let t = Instant::now();
+        physx_legal(&mut sets, &DecomposeOptions::default());
+        let ms = t.elapsed().as_secs_f64() * 1e3;
+        let q0 = metrics::measure(&m, &before);
+        let q1 = metrics::measure(&m, &sets[0]);
+        let cost = (q1.dist_p95 - q0.dist_p95) * 100.0;
+        hulls_total += before.len();
+        hulls_over += over;
+        costs.push(cost);
+        times.push(ms);
+        println!(
+            "| {id} | {} | {over} | {max_p} | {:.3} | {:.3} | {cost:+.3} | {ms:.1} |",
+            before.len(),
+            q0.dist_p95 * 100.0,
+            q1.dist_p95 * 100.0
+        );
+    }
+    let mean = costs.iter().sum::<f64>() / costs.len().max(1) as f64;
+    println!(
+        "\n{} objects, {hulls_over} of {hulls_total} hulls over 64 polygons. p95 cost of the limit (percentage points of the diagonal): mean {mean:+.3}, median {:+.3}, 95th percentile {:+.3}, worst {:+.3}. Reduction time: mean {:.1} ms, worst {:.1} ms per object.",
+        costs.len(),
+        pct(&costs, 0.5),
+        pct(&costs, 0.95),
+        costs.iter().cloned().fold(f64::NEG_INFINITY, f64::max),
+        times.iter().sum::<f64>() / times.len().max(1) as f64,
+        times.iter().cloned().fold(0.0, f64::max)
+    );
+}
+
+fn main() {
+    let args: Vec<String> = std::env::args().collect();
+    let python = args
+        .iter()
+        .position(|a| a == "--python")
+        .and_then(|i| args.get(i + 1).cloned())
+        .or_else(|| std::env::var("INTERACT3D_USD_PYTHON").ok())
+        .unwrap_or_else(|| "python3".into());
+    if !args.iter().any(|a| a == "--no-scenes") {
+        sweep_scenes(&python);
+    }
+    if !args.iter().any(|a| a == "--no-objects") && Path::new(&shared()).exists() {
+        sweep_objects();
+    }
+}

@@ -1,0 +1,376 @@
+//! USD export: `scene.usda` and one `<object>.usda` per object, text USD rendered from the
+//! templates `scene.usda.j2` and `object.usda.j2` (UsdPhysics + PhysX schemas).
+//!
+//! Entry point: [`write_usd`], called by [`super::export`] after the mesh files are written (the
+//! object files read the PNG textures under `meshes/`). [`principal_axes`] turns a full inertia
+//! tensor into USD's diagonal inertia and principal-axes quaternion.
+//!
+//! Each object file: an Xform default prim with `PhysicsRigidBodyAPI` + `PhysicsMassAPI` (mass,
+//! centre of mass, diagonal inertia, principal axes), `Looks` (a physics material, one
+//! `UsdPreviewSurface` per visual material reading our PNGs), `Visuals` (meshes with normals and
+//! UVs) and `Collisions` (one guide-purpose `Mesh` per hull, `convexHull` approximation,
+//! `PhysxConvexHullCollisionAPI` vertex limit 64, bound to the physics material). The scene
+//! file: a `PhysicsScene` with gravity, a static ground box, and every object referenced at its
+//! initial pose, the composed pose in `customData`, fixed objects static.
+
+use super::files::{material_groups, BodyFiles};
+use super::format::f;
+use super::{Templates, GENERATOR};
+use crate::body::{Assembly, Body};
+use crate::error::Result;
+use crate::mesh::{P3, V3};
+use nalgebra::{Matrix3, Rotation3, UnitQuaternion, Vector3};
+use serde::Serialize;
+use std::fmt::Write as _;
+use std::path::Path;
+
+#[derive(Clone, Serialize)]
+struct MaterialCtx {
+    prim: String,
+    color: String,
+    opacity: String,
+    texture: Option<String>,
+}
+
+#[derive(Clone, Serialize)]
+struct MeshCtx {
+    prim: String,
+    material: String,
+    points: String,
+    counts: String,
+    indices: String,
+    normals: String,
+    st: Option<String>,
+    extent: String,
+}
+
+#[derive(Clone, Serialize)]
+struct ObjectCtx {
+    prim: String,
+    name: String,
+    file: String,
+    mass: String,
+    com: String,
+    diagonal_inertia: String,
+    principal_axes: String,
+    friction: String,
+    fixed: bool,
+    fixed_usd: &'static str,
+    pos: String,
+    orient: String,
+    composed_pos: String,
+    composed_orient: String,
+    materials: Vec<MaterialCtx>,
+    visuals: Vec<MeshCtx>,
+    hulls: Vec<MeshCtx>,
+}
+
+/// Write `scene.usda` and `<object>.usda` for every body into `dir` (the export folder, whose
+/// `meshes/` already holds the textures named in `files`, one entry per body).
+pub fn write_usd(
+    a: &Assembly,
+    files: &[BodyFiles],
+    dir: &Path,
+    templates: &Templates,
+    floor_friction: f64,
+) -> Result<()> {
+    let prims = prim_names(a.bodies.iter().map(|b| b.name.as_str()));
+    let mut objects = Vec::with_capacity(a.bodies.len());
+    for ((b, fl), prim) in a.bodies.iter().zip(files).zip(prims) {
+        let ctx = object_context(b, fl, prim);
+        let text = templates.render(
+            "object.usda.j2",
+            minijinja::context! { generator => GENERATOR, b => ctx.clone() },
+        )?;
+        crate::fsutil::write(&dir.join(&ctx.file), text.as_bytes())?;
+        // The scene needs no mesh data.
+        objects.push(ObjectCtx {
+            materials: Vec::new(),
+            visuals: Vec::new(),
+            hulls: Vec::new(),
+            ..ctx
+        });
+    }
+    let text = templates.render(
+        "scene.usda.j2",
+        minijinja::context! {
+            generator => GENERATOR,
+            bodies => objects,
+            floor_friction => f(floor_friction),
+        },
+    )?;
+    crate::fsutil::write(&dir.join("scene.usda"), text.as_bytes())
+}
+
+/// USD prim names for object names: `-` and anything else outside `[A-Za-z0-9_]` become `_`, a
+/// leading digit gets a `_`, and a name taken twice gets `_2`, `_3`… (object names are unique,
+/// but `a-b` and `a_b` are one prim name).
+fn prim_names<'a>(names: impl Iterator<Item = &'a str>) -> Vec<String> {
+    let mut out: Vec<String> = Vec::new();
+    for n in names {
+        let mut p: String = n
+            .chars()
+            .map(|c| if c.is_ascii_alphanumeric() { c } else { '_' })
+            .collect();
+        if !p.starts_with(|c: char| c.is_ascii_alphabetic() || c == '_') {
+            p.insert(0, '_');
+        }
+        let base = p.clone();
+        let mut k = 2;
+        while out.contains(&p) || p == "World" {
+            p = format!("{base}_{k}");
+            k += 1;
+        }
+        out.push(p);
+    }
+    out
+}
+
+fn object_context(b: &Body, files: &BodyFiles, prim: String) -> ObjectCtx {
+    let (diag, axes) = principal_axes(&b.inertial.inertia);
+    let c = b.inertial.com;
+    let groups = material_groups(b);
+    let materials: Vec<MaterialCtx> = files
+        .materials
+        .iter()
+        .enumerate()
+        .map(|(k, m)| MaterialCtx {
+            prim: format!("Material_{k:02}"),
+            color: tuple(&[m.rgba[0], m.rgba[1], m.rgba[2]]),
+            opacity: f(m.rgba[3]),
+            texture: m.texture.as_ref().map(|t| format!("./meshes/{t}")),
+        })
+        .collect();
+    let mut visuals = Vec::new();
+    for (k, (_, parts)) in groups.iter().enumerate() {
+        for p in parts {
+            visuals.push(MeshCtx {
+                prim: format!("Visual_{:02}", visuals.len()),
+                material: materials[k].prim.clone(),
+                points: points(&p.positions),
+                counts: counts(p.triangles.len()),
+                indices: indices(&p.triangles),
+                normals: points(&vertex_normals(&p.positions, &p.triangles)),
+                // glTF's v grows downwards, USD's st upwards.
+                st: p.uvs.as_ref().map(|uv| {
+                    let mut s = String::from("[");
+                    for (i, t) in uv.iter().enumerate() {
+                        if i > 0 {
+                            s.push_str(", ");
+                        }
+                        write!(s, "({}, {})", f(t[0]), f(1.0 - t[1])).unwrap();
+                    }
+                    s.push(']');
+                    s
+                }),
+                extent: extent(&p.positions),
+            });
+        }
+    }
+    let hulls = b
+        .hulls
+        .iter()
+        .enumerate()
+        .map(|(k, h)| MeshCtx {
+            prim: format!("Hull_{k:02}"),
+            material: String::new(),
+            points: points(&h.vertices),
+            counts: counts(h.triangles.len()),
+            indices: indices(&h.triangles),
+            normals: String::new(),
+            st: None,
+            extent: extent(&h.vertices),
+        })
+        .collect();
+    let quat = |q: &UnitQuaternion<f64>| tuple(&[q.w, q.i, q.j, q.k]);
+    let pos = |v: &Vector3<f64>| tuple(&[v.x, v.y, v.z]);
+    ObjectCtx {
+        file: format!("{}.usda", b.name),
+        name: b.name.clone(),
+        prim,
+        mass: f(b.inertial.mass),
+        com: tuple(&[c.x, c.y, c.z]),
+        diagonal_inertia: tuple(&[diag.x, diag.y, diag.z]),
+        principal_axes: quat(&axes),
+        friction: f(b.friction),
+        fixed: b.fixed,
+        fixed_usd: if b.fixed { "true" } else { "false" },
+        pos: pos(&b.pose.translation.vector),
+        orient: quat(&b.pose.rotation),
+        composed_pos: pos(&b.composed_pose.translation.vector),
+        composed_orient: quat(&b.composed_pose.rotation),
+        materials,
+        visuals,
+        hulls,
+    }
+}
+
+/// USD's form of a full inertia tensor `i` (body frame): the principal moments and the rotation
+/// whose columns are the principal axes, `i = R·diag(d)·Rᵀ`. Deterministic: a tensor already
+/// diagonal (off-diagonal terms under 1e-12 of the largest moment) keeps its axes and the
+/// identity; otherwise the moments are sorted ascending, each axis points so that its largest
+/// component is positive, the third axis is flipped if needed to make a rotation, and the
+/// quaternion has `w ≥ 0`.
+pub fn principal_axes(i: &Matrix3<f64>) -> (Vector3<f64>, UnitQuaternion<f64>) {
+    let scale = (0..3).map(|k| i[(k, k)].abs()).fold(0.0, f64::max);
+    let off = [i[(0, 1)], i[(0, 2)], i[(1, 2)]]
+        .iter()
+        .map(|x| x.abs())
+        .fold(0.0, f64::max);
+    if off <= 1e-12 * scale {
+        return (
+            Vector3::new(i[(0, 0)], i[(1, 1)], i[(2, 2)]),
+            UnitQuaternion::identity(),
+        );
+    }
+    let sym = (i + i.transpose()) * 0.5;
+    let e = sym.symmetric_eigen();
+    let mut order = [0usize, 1, 2];
+    order.sort_by(|&a, &b| {
+        e.eigenvalues[a]
+            .total_cmp(&e.eigenvalues[b])
+            .then(a.cmp(&b))
+    });
+    let mut r = Matrix3::zeros();
+    for (col, &k) in order.iter().enumerate() {
+        let mut v: Vector3<f64> = e.eigenvectors.column(k).into_owned();
+        let big = (0..3)
+            .max_by(|&a, &b| v[a].abs().total_cmp(&v[b].abs()).then(b.cmp(&a)))
+            .unwrap();
+        if v[big] < 0.0 {
+            v = -v;
+        }
+        r.set_column(col, &v.normalize());
+    }
+    if r.determinant() < 0.0 {
+        let c = -r.column(2).into_owned();
+        r.set_column(2, &c);
+    }
+    let mut q = UnitQuaternion::from_rotation_matrix(&Rotation3::from_matrix(&r));
+    if q.w < 0.0 {
+        q = UnitQuaternion::new_unchecked(-q.into_inner());
+    }
+    let d = Vector3::new(
+        e.eigenvalues[order[0]],
+        e.eigenvalues[order[1]],
+        e.eigenvalues[order[2]],
+    );
+    (d, q)
+}
+
+fn tuple(v: &[f64]) -> String {
+    let s: Vec<String> = v.iter().map(|x| f(*x)).collect();
+    format!("({})", s.join(", "))
+}
+
+fn points(ps: &[P3]) -> String {
+    let mut s = String::with_capacity(ps.len() * 36 + 2);
+    s.push('[');
+    for (i, p) in ps.iter().enumerate() {
+        if i > 0 {
+            s.push_str(", ");
+        }
+        write!(s, "({}, {}, {})", f(p.x), f(p.y), f(p.z)).unwrap();
+    }
+    s.push(']');
+    s
+}
+
+fn counts(n: usize) -> String {
+    format!("[{}]", vec!["3"; n].join(", "))
+}
+
+fn indices(t: &[[u32; 3]]) -> String {
+    let mut s = String::with_capacity(t.len() * 18 + 2);
+    s.push('[');
+    for (i, t) in t.iter().enumerate() {
+        if i > 0 {
+            s.push_str(", ");
+        }
+        write!(s, "{}, {}, {}", t[0], t[1], t[2]).unwrap();
+    }
+    s.push(']');
+    s
+}
+
+fn extent(ps: &[P3]) -> String {
+    let mut lo = P3::new(f64::INFINITY, f64::INFINITY, f64::INFINITY);
+    let mut hi = -lo;
+    for p in ps {
+        lo = lo.inf(p);
+        hi = hi.sup(p);
+    }
+    if ps.is_empty() {
+        lo = P3::origin();
+        hi = P3::origin();
+    }
+    format!(
+        "[{}, {}]",
+        tuple(&[lo.x, lo.y, lo.z]),
+        tuple(&[hi.x, hi.y, hi.z])
+    )
+}
+
+/// Area-weighted vertex normals (a vertex no triangle uses gets +Z).
+fn vertex_normals(ps: &[P3], tris: &[[u32; 3]]) -> Vec<P3> {
+    let mut n = vec![V3::zeros(); ps.len()];
+    for t in tris {
+        let [a, b, c] = t.map(|k| ps[k as usize]);
+        let w = (b - a).cross(&(c - a));
+        for k in t {
+            n[*k as usize] += w;
+        }
+    }
+    n.into_iter()
+        .map(|v| {
+            let len = v.norm();
+            P3::from(if len > 0.0 { v / len } else { V3::z() })
+        })
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn rebuilt(d: &Vector3<f64>, q: &UnitQuaternion<f64>) -> Matrix3<f64> {
+        let r = q.to_rotation_matrix().into_inner();
+        r * Matrix3::from_diagonal(d) * r.transpose()
+    }
+
+    #[test]
+    fn principal_axes_rebuild_the_tensor() {
+        // A box's tensor turned by a known rotation: the moments come back sorted, the tensor
+        // rebuilds to 1e-12 relative, and a turned copy of the same input gives the same output.
+        let base = Matrix3::from_diagonal(&Vector3::new(3e-4, 1e-4, 2e-4));
+        let rot = UnitQuaternion::from_euler_angles(0.3, -0.7, 1.1);
+        let r = rot.to_rotation_matrix().into_inner();
+        let i = r * base * r.transpose();
+        let (d, q) = principal_axes(&i);
+        assert!(
+            (d.x - 1e-4).abs() < 1e-15 && (d.y - 2e-4).abs() < 1e-15 && (d.z - 3e-4).abs() < 1e-15
+        );
+        assert!(
+            (rebuilt(&d, &q) - i).norm() < 1e-12 * i.norm(),
+            "{i} vs {}",
+            rebuilt(&d, &q)
+        );
+        assert!(q.w >= 0.0);
+        assert_eq!(principal_axes(&i), principal_axes(&i.clone()));
+        // A diagonal tensor keeps its axes.
+        let (d, q) = principal_axes(&base);
+        assert_eq!(d, Vector3::new(3e-4, 1e-4, 2e-4));
+        assert_eq!(q, UnitQuaternion::identity());
+        // Two equal moments (a cylinder about a tilted axis): still a rotation that rebuilds it.
+        let cyl = Matrix3::from_diagonal(&Vector3::new(2e-4, 2e-4, 1e-4));
+        let i = r * cyl * r.transpose();
+        let (d, q) = principal_axes(&i);
+        assert!((rebuilt(&d, &q) - i).norm() < 1e-12 * i.norm());
+    }
+
+    #[test]
+    fn prim_names_are_usd_identifiers_and_unique() {
+        let n = prim_names(["a-b", "a_b", "3d", "World", "ok"].into_iter());
+        assert_eq!(n, vec!["a_b", "a_b_2", "_3d", "World_2", "ok"]);
+    }
+}
