@@ -1,6 +1,7 @@
 //! The `interact3d` command: argument parsing only; the work is in the library.
 //!
-//! Exit codes: 0 pass, 1 a scene failed validation, 2 bad input or usage.
+//! Exit codes: 0 pass, 1 a scene failed validation (or an asset has findings at or above
+//! `--fail-on`), 2 bad input or usage (or not one asset could be read).
 
 use clap::{Args, Parser, Subcommand};
 use interact3d::body::Engine;
@@ -24,7 +25,8 @@ struct Cli {
 enum Command {
     /// Export a scene (Interact3D sample folder or scene.json) to MJCF + URDF assets.
     Export(ExportArgs),
-    /// Check a scene or an export folder: interpenetration metrics and a Rapier settle test.
+    /// Check scenes, export folders, and URDF/MJCF assets written by anyone (files, folders,
+    /// globs, in parallel): inertia, geometry, contact and settle checks with file:line findings.
     Validate(ValidateArgs),
     /// Convert a whole dataset: every sample folder and scene.json under ROOT, in parallel,
     /// resumable, shardable; writes OUT/summary.json, summary.csv and index.html.
@@ -128,8 +130,31 @@ impl LimitsArgs {
 
 #[derive(Args)]
 struct ValidateArgs {
-    /// A scene (sample folder, scene.json, mesh file) or an export output folder.
-    path: PathBuf,
+    /// Scenes (sample folder, scene.json), export folders, URDF/MJCF files, folders holding them,
+    /// or globs ('assets/**/*.urdf').
+    #[arg(required = true, value_name = "PATH")]
+    paths: Vec<String>,
+    /// SARIF 2.1.0 of the asset findings to this file (GitHub code scanning).
+    #[arg(long, value_name = "FILE")]
+    sarif: Option<PathBuf>,
+    /// Print GitHub Actions annotations (::error file=...,line=...) on stdout.
+    #[arg(long)]
+    github: bool,
+    /// Known findings (from --write-baseline) that do not fail the run.
+    #[arg(long, value_name = "FILE")]
+    baseline: Option<PathBuf>,
+    /// Write every finding's fingerprint to this file.
+    #[arg(long, value_name = "FILE")]
+    write_baseline: Option<PathBuf>,
+    /// Lowest severity that fails the run (exit code 1).
+    #[arg(long, value_enum, value_name = "LEVEL")]
+    fail_on: Option<interact3d::validate::finding::Severity>,
+    /// Where `package://NAME/...` mesh paths of a URDF point (no ROS tools are run).
+    #[arg(long = "package", value_name = "NAME=DIR", value_parser = parse_package)]
+    packages: Vec<(String, PathBuf)>,
+    /// Skip the settle and rest tests of URDF/MJCF assets (static checks only).
+    #[arg(long)]
+    no_physics: bool,
     #[command(flatten)]
     build: BuildArgs,
     #[command(flatten)]
@@ -283,6 +308,14 @@ enum ProgressArg {
     Bar,
     Lines,
     Quiet,
+}
+
+fn parse_package(s: &str) -> Result<(String, PathBuf), String> {
+    let (name, dir) = s.split_once('=').ok_or("expected NAME=DIR")?;
+    if name.is_empty() || dir.is_empty() {
+        return Err("expected NAME=DIR".into());
+    }
+    Ok((name.to_string(), PathBuf::from(dir)))
 }
 
 /// `NAME=VALUE` with a positive finite value in `unit`.
@@ -447,10 +480,24 @@ fn run(cli: Cli) -> Result<ExitCode, Error> {
             );
             Ok(ExitCode::SUCCESS)
         }
-        Command::Validate(a) => {
-            let t = std::time::Instant::now();
+        Command::Validate(a) => validate(a),
+    }
+}
+
+fn validate(a: ValidateArgs) -> Result<ExitCode, Error> {
+    use interact3d::validate::ci;
+    let t = std::time::Instant::now();
+    let entries = ci::discover(&a.paths)?;
+    let ci_flags = a.sarif.is_some()
+        || a.github
+        || a.baseline.is_some()
+        || a.write_baseline.is_some()
+        || a.fail_on.is_some();
+    if let ([e], false) = (entries.as_slice(), ci_flags) {
+        if e.kind == ci::Kind::Scene {
+            // One scene or export folder: the scene report as before.
             let (assembly, v) = interact3d::pipeline::validate_path(
-                &a.path,
+                &e.path,
                 &a.limits.limits(),
                 &a.build.options(),
                 &a.check.options(),
@@ -476,13 +523,58 @@ fn run(cli: Cli) -> Result<ExitCode, Error> {
                     interact3d::validate::junit(&assembly.name, &v).as_bytes(),
                 )?;
             }
-            Ok(if v.passed {
+            return Ok(if v.passed {
                 ExitCode::SUCCESS
             } else {
                 ExitCode::from(1)
-            })
+            });
         }
     }
+    let mut opts = ci::RunOptions {
+        scene_build: a.build.options(),
+        scene_validate: a.check.options(),
+        fail_on: a.fail_on,
+        ..Default::default()
+    };
+    opts.asset.read.limits = a.limits.limits();
+    opts.asset.read.packages = a.packages.clone();
+    opts.asset.physics = !a.no_physics;
+    opts.asset.settle = interact3d::physics::SettleOptions {
+        perturbation_speed: opts.asset.settle.perturbation_speed,
+        ..a.check.options().settle
+    };
+    if let Some(b) = &a.baseline {
+        opts.baseline = ci::read_baseline(b)?;
+    }
+    let run = ci::run(&entries, &opts);
+    eprint!("{}", ci::table(&run));
+    eprintln!(
+        "validated {} assets in {:.2} s",
+        run.reports.len(),
+        t.elapsed().as_secs_f64()
+    );
+    let pretty = |v: &serde_json::Value| {
+        serde_json::to_string_pretty(v).map_err(|e| Error::Internal(e.to_string()))
+    };
+    if a.json {
+        println!("{}", pretty(&ci::json(&run))?);
+    }
+    if a.github {
+        print!("{}", ci::github(&run));
+    }
+    if let Some(f) = &a.sarif {
+        interact3d::fsutil::write_atomically(f, (pretty(&ci::sarif(&run))? + "\n").as_bytes())?;
+    }
+    if let Some(f) = &a.junit {
+        interact3d::fsutil::write_atomically(f, ci::junit(&run).as_bytes())?;
+    }
+    if let Some(f) = &a.write_baseline {
+        interact3d::fsutil::write_atomically(
+            f,
+            (pretty(&ci::baseline_json(&run))? + "\n").as_bytes(),
+        )?;
+    }
+    Ok(ExitCode::from(ci::exit_code(&run)))
 }
 
 fn batch(a: BatchArgs) -> Result<ExitCode, Error> {

@@ -1,11 +1,17 @@
-//! File formats: mesh readers (glTF/GLB, OBJ+MTL, STL), texture reading, and the writers the
-//! export and the fixtures use. Readers check what they read and name the file in every error.
+//! File formats: mesh readers (glTF/GLB, OBJ+MTL, STL, MuJoCo `.msh`), texture reading,
+//! robot-description readers (URDF, MJCF → [`asset::Asset`]) and the writers the export and the
+//! fixtures use. Readers check what they read and name the file (and line) in every error.
 
+pub mod asset;
 pub mod glb_write;
 pub mod gltf;
+pub mod mjcf;
+pub mod msh;
 pub mod obj;
 pub mod stl;
 pub mod texture;
+pub mod urdf;
+pub mod xml;
 
 pub use glb_write::{to_glb_bytes, to_glb_bytes_with, write_glb, write_glb_with, GlbOptions};
 

@@ -182,3 +182,44 @@ fn check_indices(path: &Path, text: &str) -> Result<()> {
     }
     Ok(())
 }
+
+/// Geometry only: one part per OBJ object or group (`o`/`g`), materials and textures ignored
+/// (what a physics engine reads; PyBullet makes each part of a V-HACD file its own convex
+/// shape). Indices are checked as in [`load_bytes`].
+pub fn load_geometry_bytes(path: &Path, bytes: &[u8], limits: &Limits) -> Result<VisualMesh> {
+    let text = String::from_utf8_lossy(bytes);
+    check_indices(path, &text)?;
+    let opts = tobj::LoadOptions {
+        triangulate: true,
+        single_index: true,
+        ignore_points: true,
+        ignore_lines: true,
+    };
+    let (models, _) = tobj::load_obj_buf(&mut &bytes[..], &opts, |_| {
+        Err(tobj::LoadError::OpenFileFailed)
+    })
+    .map_err(|e| Error::input(path, format!("cannot parse OBJ: {e}")))?;
+    let parts: Vec<VisualPart> = models
+        .iter()
+        .filter(|m| !m.mesh.indices.is_empty())
+        .map(|model| VisualPart {
+            positions: model
+                .mesh
+                .positions
+                .chunks_exact(3)
+                .map(|c| P3::new(c[0], c[1], c[2]))
+                .collect(),
+            uvs: None,
+            triangles: model
+                .mesh
+                .indices
+                .chunks_exact(3)
+                .map(|c| [c[0], c[1], c[2]])
+                .collect(),
+            material: Material::default(),
+        })
+        .collect();
+    let mesh = VisualMesh { parts };
+    crate::io::check_visual(path, &mesh, limits)?;
+    Ok(mesh)
+}

@@ -9,6 +9,15 @@
 //!
 //! Every check is a [`Check`] with its value and limit, so a report, a table and JUnit XML all
 //! come from the same list.
+//!
+//! Entry points: [`validate`] (a built or exported scene), [`table`], [`junit`]; for URDF/MJCF
+//! assets written by anyone: [`asset::check_path`] (findings with check ids, severities, file
+//! and line), [`finding`] (the finding model), [`ci`] (the many-asset run and its outputs:
+//! table, JSON, SARIF, GitHub annotations, JUnit, baselines).
+
+pub mod asset;
+pub mod ci;
+pub mod finding;
 
 use crate::body::Assembly;
 use crate::error::{Error, Result};
@@ -169,67 +178,7 @@ pub fn validate(a: &Assembly, opts: &ValidateOptions) -> Result<Validation> {
         path: a.name.clone().into(),
         message: format!("cannot simulate: {e}"),
     })?;
-    let s = &opts.settle;
-    for b in &settle.bodies {
-        if b.fixed {
-            continue;
-        }
-        let settle_ok = b.relative_drift <= s.max_relative_drift
-            && b.settle_shape_shift
-                .is_none_or(|shift| shift <= s.max_relative_drift * b.bbox_diagonal)
-            && !b.left_supports
-            && !b.ended_on_floor;
-        let settle_reasons: Vec<&String> = b
-            .reasons
-            .iter()
-            .filter(|r| !r.contains("rest check"))
-            .collect();
-        checks.push(Check {
-            name: "settle".into(),
-            subject: b.name.clone(),
-            passed: settle_ok && b.initial_penetration <= s.max_initial_penetration,
-            value: b.settle_displacement,
-            limit: s.max_relative_drift * b.bbox_diagonal,
-            message: if settle_reasons.is_empty() {
-                format!(
-                    "moved {:.3} mm, turned {:.2}° while settling",
-                    b.settle_displacement * 1e3,
-                    b.settle_rotation_deg
-                )
-            } else {
-                settle_reasons
-                    .iter()
-                    .map(|r| r.as_str())
-                    .collect::<Vec<_>>()
-                    .join("; ")
-            },
-        });
-        let rest_ok = b.rest_displacement <= s.max_rest_motion
-            && b.rest_rotation_deg <= s.max_rest_rotation_deg
-            && b.rest_max_penetration <= s.max_rest_penetration;
-        checks.push(Check {
-            name: "rest".into(),
-            subject: b.name.clone(),
-            passed: rest_ok,
-            value: b.rest_displacement,
-            limit: s.max_rest_motion,
-            message: match b
-                .reasons
-                .iter()
-                .filter(|r| r.contains("rest check"))
-                .cloned()
-                .collect::<Vec<_>>()
-            {
-                r if !r.is_empty() => r.join("; "),
-                _ => format!(
-                    "at rest: moved {:.3} mm, turned {:.3}°, contact penetration {:.3} mm",
-                    b.rest_displacement * 1e3,
-                    b.rest_rotation_deg,
-                    b.rest_max_penetration * 1e3
-                ),
-            },
-        });
-    }
+    checks.extend(dynamic_checks(&settle, &opts.settle));
     warnings.extend(settle.warnings.iter().cloned());
     let passed = checks.iter().all(|c| c.passed) && settle.passed;
     Ok(Validation {
@@ -326,4 +275,70 @@ pub fn junit(scene: &str, v: &Validation) -> String {
     }
     s += "  </testsuite>\n</testsuites>\n";
     s
+}
+
+/// The settle and rest checks of every dynamic body of a settle report.
+pub fn dynamic_checks(settle: &SettleReport, s: &crate::physics::SettleOptions) -> Vec<Check> {
+    let mut checks = Vec::new();
+    for b in &settle.bodies {
+        if b.fixed {
+            continue;
+        }
+        let settle_ok = b.relative_drift <= s.max_relative_drift
+            && b.settle_shape_shift
+                .is_none_or(|shift| shift <= s.max_relative_drift * b.bbox_diagonal)
+            && !b.left_supports
+            && !b.ended_on_floor;
+        let settle_reasons: Vec<&String> = b
+            .reasons
+            .iter()
+            .filter(|r| !r.contains("rest check"))
+            .collect();
+        checks.push(Check {
+            name: "settle".into(),
+            subject: b.name.clone(),
+            passed: settle_ok && b.initial_penetration <= s.max_initial_penetration,
+            value: b.settle_displacement,
+            limit: s.max_relative_drift * b.bbox_diagonal,
+            message: if settle_reasons.is_empty() {
+                format!(
+                    "moved {:.3} mm, turned {:.2}° while settling",
+                    b.settle_displacement * 1e3,
+                    b.settle_rotation_deg
+                )
+            } else {
+                settle_reasons
+                    .iter()
+                    .map(|r| r.as_str())
+                    .collect::<Vec<_>>()
+                    .join("; ")
+            },
+        });
+        let rest_ok = b.rest_displacement <= s.max_rest_motion
+            && b.rest_rotation_deg <= s.max_rest_rotation_deg
+            && b.rest_max_penetration <= s.max_rest_penetration;
+        checks.push(Check {
+            name: "rest".into(),
+            subject: b.name.clone(),
+            passed: rest_ok,
+            value: b.rest_displacement,
+            limit: s.max_rest_motion,
+            message: match b
+                .reasons
+                .iter()
+                .filter(|r| r.contains("rest check"))
+                .cloned()
+                .collect::<Vec<_>>()
+            {
+                r if !r.is_empty() => r.join("; "),
+                _ => format!(
+                    "at rest: moved {:.3} mm, turned {:.3}°, contact penetration {:.3} mm",
+                    b.rest_displacement * 1e3,
+                    b.rest_rotation_deg,
+                    b.rest_max_penetration * 1e3
+                ),
+            },
+        });
+    }
+    checks
 }
