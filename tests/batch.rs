@@ -230,7 +230,9 @@ fn shards_cover_every_scene_exactly_once_and_merge_back() {
     };
     let all = list(&[]);
     assert_eq!(all, made.iter().map(|m| m.rel.clone()).collect::<Vec<_>>());
-    let parts: Vec<Vec<String>> = (1..=3).map(|i| list(&["--shard", &format!("{i}/3")])).collect();
+    let parts: Vec<Vec<String>> = (1..=3)
+        .map(|i| list(&["--shard", &format!("{i}/3")]))
+        .collect();
     let mut union: Vec<String> = parts.concat();
     union.sort();
     assert_eq!(union, all, "every scene in exactly one shard");
@@ -249,7 +251,11 @@ fn shards_cover_every_scene_exactly_once_and_merge_back() {
     let done = |rel: &String| out.join(rel).join("batch.json").is_file();
     let deadline = Instant::now() + Duration::from_secs(120);
     while !parts[victim].iter().any(done) {
-        assert!(Instant::now() < deadline, "no scene of shard {} in 120 s", victim + 1);
+        assert!(
+            Instant::now() < deadline,
+            "no scene of shard {} in 120 s",
+            victim + 1
+        );
         assert!(
             tasks[victim].try_wait().unwrap().is_none(),
             "shard {} finished before the kill",
@@ -264,11 +270,16 @@ fn shards_cover_every_scene_exactly_once_and_merge_back() {
         let o = task.wait_with_output().unwrap();
         let err = String::from_utf8_lossy(&o.stderr);
         assert!(
-            err.contains(&format!("shard {}/3 from Slurm array task {i} of 0..=2", i + 1)),
+            err.contains(&format!(
+                "shard {}/3 from Slurm array task {i} of 0..=2",
+                i + 1
+            )),
             "{err}"
         );
         assert!(matches!(o.status.code(), Some(0..=2)), "task {i}: {err}");
-        assert!(out.join(format!("summary.shard-{}-of-3.json", i + 1)).is_file());
+        assert!(out
+            .join(format!("summary.shard-{}-of-3.json", i + 1))
+            .is_file());
     }
     let victim_summary = out.join(format!("summary.shard-{}-of-3.json", victim + 1));
     assert!(!victim_summary.exists());
@@ -286,8 +297,14 @@ fn shards_cover_every_scene_exactly_once_and_merge_back() {
     assert!(String::from_utf8_lossy(&m.stderr).contains("missing shard"));
 
     // The crashed task is run again with the same array index: its finished scenes are reused.
-    let o = slurm_task(&root, &out, victim, 2).wait_with_output().unwrap();
-    assert!(matches!(o.status.code(), Some(0..=2)), "{}", String::from_utf8_lossy(&o.stderr));
+    let o = slurm_task(&root, &out, victim, 2)
+        .wait_with_output()
+        .unwrap();
+    assert!(
+        matches!(o.status.code(), Some(0..=2)),
+        "{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
     let vs = read_json(&victim_summary);
     assert_eq!(vs["run"]["reused"], finished);
     assert_eq!(
@@ -296,7 +313,12 @@ fn shards_cover_every_scene_exactly_once_and_merge_back() {
     );
 
     let m = merge();
-    assert_eq!(m.status.code(), Some(code_single), "{}", String::from_utf8_lossy(&m.stderr));
+    assert_eq!(
+        m.status.code(),
+        Some(code_single),
+        "{}",
+        String::from_utf8_lossy(&m.stderr)
+    );
     // Same files (scene folders byte for byte) apart from the summaries and our hidden files.
     let summaries = ["summary.json", "summary.csv", "index.html"];
     let files = |d: &Path| -> Vec<(String, Vec<u8>)> {
@@ -318,7 +340,10 @@ fn shards_cover_every_scene_exactly_once_and_merge_back() {
     }
     let merged = read_json(&out.join("summary.json"));
     assert_eq!(merged["counts"]["scenes"], made.len());
-    assert_eq!(stable(read_json(&single.join("summary.json"))), stable(merged));
+    assert_eq!(
+        stable(read_json(&single.join("summary.json"))),
+        stable(merged)
+    );
     let csv = |d: &Path| stable_csv(&std::fs::read_to_string(d.join("summary.csv")).unwrap());
     assert_eq!(csv(&single), csv(&out));
     let html = |d: &Path| stable_html(&std::fs::read_to_string(d.join("index.html")).unwrap());

@@ -27,7 +27,11 @@ fn bin_dir(t: &Path) -> String {
     let bin = t.join("bin");
     std::fs::create_dir_all(&bin).unwrap();
     std::os::unix::fs::symlink(env!("CARGO_BIN_EXE_interact3d"), bin.join("interact3d")).unwrap();
-    format!("{}:{}", bin.display(), std::env::var("PATH").unwrap_or_default())
+    format!(
+        "{}:{}",
+        bin.display(),
+        std::env::var("PATH").unwrap_or_default()
+    )
 }
 
 /// A command with no scheduler variables inherited from wherever the tests run.
@@ -203,7 +207,10 @@ fn kubernetes_indexed_job_runs_once_per_completion_index() {
     assert!(text.contains(&format!("outside 1..={n}")), "{text}");
     let merge = python_json(
         "yaml_to_json.py",
-        &[examples().join("kubernetes/merge-job.yaml").to_str().unwrap()],
+        &[examples()
+            .join("kubernetes/merge-job.yaml")
+            .to_str()
+            .unwrap()],
     );
     let c = &merge["spec"]["template"]["spec"]["containers"][0];
     let mount = c["volumeMounts"][0]["mountPath"].as_str().unwrap();
@@ -255,9 +262,10 @@ fn github_matrix_jobs_on_separate_machines_merge_from_their_artifacts() {
         let machine = t.path().join(format!("job-{s}"));
         std::fs::create_dir_all(machine.join("data")).unwrap();
         std::os::unix::fs::symlink(&root, machine.join("data/scenes")).unwrap();
-        let line = convert[0]
-            .replace("${{ matrix.shard }}", s)
-            .replace("--progress lines", &format!("--progress lines {}", FAST.join(" ")));
+        let line = convert[0].replace("${{ matrix.shard }}", s).replace(
+            "--progress lines",
+            &format!("--progress lines {}", FAST.join(" ")),
+        );
         let mut c = clean(Command::new("bash"), &path);
         c.args(["-e", "-c", &line]).current_dir(&machine);
         let (code, text) = output(c);

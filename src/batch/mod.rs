@@ -243,16 +243,16 @@ fn lock(staging: &Path, shard: Option<Shard>) -> Result<std::fs::File> {
         .write(true)
         .open(&path)
         .map_err(|e| Error::io(&path, e))?;
-    match file.try_lock() {
+    match try_lock(&file) {
         Ok(()) => Ok(file),
-        Err(std::fs::TryLockError::WouldBlock) => Err(Error::Usage(format!(
+        Err(e) if e.kind() == std::io::ErrorKind::WouldBlock => Err(Error::Usage(format!(
             "another interact3d batch is running {} in this OUT (it holds {}); \
              wait for it to end or stop it",
             shard.map_or("the whole selection".to_string(), |s| format!("shard {s}")),
             path.display()
         ))),
         // A file system without locks: go on unguarded, as before, but say so.
-        Err(std::fs::TryLockError::Error(e)) => {
+        Err(e) => {
             eprintln!(
                 "warning: cannot lock {} ({e}); make sure no other process runs the same shard",
                 path.display()
@@ -260,6 +260,19 @@ fn lock(staging: &Path, shard: Option<Shard>) -> Result<std::fs::File> {
             Ok(file)
         }
     }
+}
+
+/// An exclusive `flock`, without waiting; released when the file is closed (or the process
+/// dies, so a crashed shard leaves no stale lock).
+#[cfg(unix)]
+fn try_lock(file: &std::fs::File) -> std::io::Result<()> {
+    use rustix::fs::{flock, FlockOperation};
+    flock(file, FlockOperation::NonBlockingLockExclusive).map_err(std::io::Error::from)
+}
+
+#[cfg(not(unix))]
+fn try_lock(_file: &std::fs::File) -> std::io::Result<()> {
+    Err(std::io::Error::other("no file locks on this platform"))
 }
 
 struct Ctx<'a> {

@@ -192,16 +192,22 @@ fn a_second_process_of_the_same_shard_is_refused_and_others_go_on() {
     // Another process holds shard 1/2 (an open file lock, as run() takes it) and has started
     // its staging folder; OUT has no marker yet, which must not make shard 2 refuse OUT.
     let held = std::fs::File::create(out.join(".interact3d-staging-1-of-2.lock")).unwrap();
-    held.try_lock().unwrap();
+    try_lock(&held).unwrap();
     std::fs::create_dir(out.join(".interact3d-staging-1-of-2")).unwrap();
     let calls = AtomicUsize::new(0);
     let mut opts = BatchOptions::new(&root, &out, ExportJob::default());
     opts.progress = Progress::Quiet;
     opts.shard = Some(Shard { index: 1, count: 2 });
     let e = run_with(&opts, &worker(&calls)).unwrap_err().to_string();
-    assert!(e.contains("another interact3d batch is running shard 1/2"), "{e}");
+    assert!(
+        e.contains("another interact3d batch is running shard 1/2"),
+        "{e}"
+    );
     assert_eq!(calls.load(Ordering::SeqCst), 0);
-    assert!(out.join(".interact3d-staging-1-of-2").is_dir(), "left alone");
+    assert!(
+        out.join(".interact3d-staging-1-of-2").is_dir(),
+        "left alone"
+    );
     opts.shard = Some(Shard { index: 2, count: 2 });
     let s = run_with(&opts, &worker(&calls)).unwrap();
     assert_eq!(s.counts.scenes, calls.load(Ordering::SeqCst));
@@ -213,7 +219,11 @@ fn a_second_process_of_the_same_shard_is_refused_and_others_go_on() {
     use std::os::unix::fs::PermissionsExt;
     let mode = |p: &Path| std::fs::metadata(p).unwrap().permissions().mode() & 0o777;
     std::fs::write(t.path().join("plain"), b"").unwrap();
-    for f in [MARKER, "summary.shard-1-of-2.json", "summary.shard-2-of-2.json"] {
+    for f in [
+        MARKER,
+        "summary.shard-1-of-2.json",
+        "summary.shard-2-of-2.json",
+    ] {
         assert_eq!(mode(&out.join(f)), mode(&t.path().join("plain")), "{f}");
     }
 }
