@@ -205,8 +205,10 @@ def run_physx(out, seconds, dt):
                     w.commit_sync(g)
 
     debug_render({"enabled": 1, "scale": 1.0, "collisionShapes": 1.0})
-    physx.step_sync(1e-6)
+    # The shipped pose, before any step (a tiny first step would turn a contact's last micrometre
+    # into a depenetration kick: velocity = depth / dt).
     start = read_bodies(["position", "orientation", "mass"])
+    physx.step_sync(dt)
     def read_lines():
         lines = []
         with physx.read_sync(SimObjectType.DEBUG_RENDER, ["linePosition"]) as result:
@@ -217,8 +219,8 @@ def run_physx(out, seconds, dt):
 
     lines = read_lines()
     debug_render({"enabled": 0})
-    steps = int(round(seconds / dt))
-    for _ in range(steps):
+    steps = max(1, int(round(seconds / dt)))
+    for _ in range(steps - 1):
         physx.step_sync(dt)
     end = read_bodies(["position", "orientation"])
     import gc
