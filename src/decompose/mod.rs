@@ -11,7 +11,7 @@ mod hull;
 pub mod scene_aware;
 pub mod vhacd;
 
-pub use hull::{Hull, PhysxLimits};
+pub use hull::{Hull, PhysxLimits, PHYSX_PLANE_TOLERANCE};
 
 use crate::error::Result;
 use crate::mesh::Mesh;
@@ -168,6 +168,11 @@ pub fn physx_legal(sets: &mut [Vec<Hull>], opts: &DecomposeOptions) -> Vec<Legal
             usize::MAX
         } else {
             PhysxLimits::default().max_polygon_vertices
+        },
+        plane_tolerance: if opts.max_polygons == usize::MAX {
+            None
+        } else {
+            PhysxLimits::default().plane_tolerance
         },
     };
     sets.iter_mut()
