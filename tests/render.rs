@@ -300,3 +300,62 @@ fn batch_index_and_scene_pages_load_in_a_browser() {
     assert!(shot.is_file(), "no screenshot at {}", shot.display());
     eprintln!("screenshot: {}", shot.display());
 }
+
+#[test]
+fn export_and_validate_take_render() {
+    let tmp = tempfile::tempdir().unwrap();
+    let scene = fixture();
+    // validate --render DIR: the page carries this validation's failed check.
+    let pics = tmp.path().join("pics");
+    let (code, _, err) = run(&[
+        "validate",
+        scene.to_str().unwrap(),
+        "--engine",
+        "vhacd",
+        "--points",
+        "20000",
+        "--render",
+        pics.to_str().unwrap(),
+        "--image-size",
+        "64",
+        "--section-size",
+        "64",
+    ]);
+    assert_eq!(code, 1, "the sunk box fails validation: {err}");
+    let page = std::fs::read_to_string(pics.join("index.html")).unwrap();
+    assert!(page.contains("\"passed\":false") && page.contains("static_penetration"));
+    let views: Value =
+        serde_json::from_slice(&std::fs::read(pics.join("views.json")).unwrap()).unwrap();
+    // 6 views + 6 hull views + 3 sections of the one pair.
+    assert_eq!(views["images"].as_array().unwrap().len(), 15);
+    for i in views["images"].as_array().unwrap() {
+        let img = png(&pics.join(i["file"].as_str().unwrap()));
+        assert_eq!(img.dimensions(), (64, 64));
+    }
+    // export --render: the same pictures inside the export, beside report.json.
+    let out = tmp.path().join("exp");
+    let code = common::export(
+        &scene,
+        &out,
+        &[
+            "--engine",
+            "vhacd",
+            "--points",
+            "20000",
+            "--render",
+            "--image-size",
+            "64",
+            "--section-size",
+            "64",
+        ],
+    );
+    assert_eq!(code, 1);
+    for i in views["images"].as_array().unwrap() {
+        let f = i["file"].as_str().unwrap();
+        assert_eq!(
+            std::fs::read(out.join("render").join(f)).unwrap(),
+            std::fs::read(pics.join(f)).unwrap(),
+            "{f}: export and validate draw the same composed scene"
+        );
+    }
+}

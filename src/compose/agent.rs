@@ -107,14 +107,8 @@ fn copy_tree(from: &Path, to: &Path) -> Result<()> {
 
 /// Largest pair penetration over the smaller object's bounding-box diagonal, from a composed
 /// folder's penetration check and the composed meshes.
-fn penetration_ratio(
-    sample_dir: &Path,
-    composed: &Path,
-    check: &Value,
-    limits: &Limits,
-) -> Result<f64> {
+fn penetration_ratio(composed: &Path, check: &Value, limits: &Limits) -> Result<f64> {
     let scene = crate::scene::load(composed, limits)?;
-    let _ = sample_dir;
     let diag = |name: &str| -> f64 {
         scene
             .objects
@@ -138,18 +132,15 @@ fn penetration_ratio(
     Ok(worst)
 }
 
-/// The command's answer: object name → (new object mesh, new guidance mesh).
+/// Replacement files of one object: (name, new object mesh, new guidance mesh).
+type Replacement = (String, Option<PathBuf>, Option<PathBuf>);
+
+/// The command's answer: the replacements and the optional note.
 fn parse_answer(
     stdout: &str,
     work: &Path,
     names: &[String],
-) -> std::result::Result<
-    (
-        Vec<(String, Option<PathBuf>, Option<PathBuf>)>,
-        Option<String>,
-    ),
-    String,
-> {
+) -> std::result::Result<(Vec<Replacement>, Option<String>), String> {
     let v: Value = serde_json::from_str(stdout.trim()).map_err(|e| {
         format!(
             "its stdout is not a JSON object ({e}); first bytes: {:?}",
@@ -259,7 +250,7 @@ pub fn compose_with_agent(
     let compose_into = |n: usize| -> Result<(PathBuf, Value, f64)> {
         let dir = w.join(format!("compose_{n:02}"));
         let (_, check) = compose_folder(&sample, &dir, o, limits, true)?;
-        let ratio = penetration_ratio(&sample, &dir, &check, limits)?;
+        let ratio = penetration_ratio(&dir, &check, limits)?;
         Ok((dir, check, ratio))
     };
     let (mut composed, mut check, mut ratio) = compose_into(0)?;
@@ -272,8 +263,10 @@ pub fn compose_with_agent(
         let files = rec.join("files");
         crate::fsutil::create_dir(&files)?;
         // What the command sees: the composed scene drawn, and the report.
-        let mut build = crate::body::BuildOptions::default();
-        build.engine = crate::body::Engine::Vhacd;
+        let mut build = crate::body::BuildOptions {
+            engine: crate::body::Engine::Vhacd,
+            ..Default::default()
+        };
         build.decompose.max_hulls = 8;
         let assembly = crate::pipeline::load_assembly(&composed, limits, &build)?;
         let render_dir = rec.join("render");
