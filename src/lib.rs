@@ -4,7 +4,7 @@
 //! The modules follow the data through the pipeline:
 //! [`mesh`] (the model) → [`io`] (file formats) → [`scene`] (sample folders and manifests) →
 //! [`prepare`] (metres, Z-up, on the ground) → [`decompose`] (convex hulls) → [`inertia`] →
-//! [`export`] (MJCF, URDF) → [`metrics`] and [`physics`] (validation).
+//! [`export`] (MJCF, URDF) → [`metrics`] and [`physics`] (validation) → [`render`] (pictures).
 
 // `!(x > 0.0)` is written on purpose throughout: unlike `x <= 0.0` it is also true for NaN,
 // so a guard written that way rejects NaN input too.
@@ -27,6 +27,7 @@ pub mod physics;
 pub mod pipeline;
 pub mod pose;
 pub mod prepare;
+pub mod render;
 pub mod report;
 pub mod rng;
 pub mod scene;

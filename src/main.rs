@@ -34,6 +34,48 @@ enum Command {
     /// Register each object_*.glb onto its guidance_object_*.glb (Interact3D's composition, on
     /// a CPU, no learned weights); writes OUT/metadata.json, OUT/scene.json and the GLBs.
     Compose(ComposeArgs),
+    /// Draw a scene or export folder (CPU, deterministic PNGs): six views, the same views of the
+    /// collision hulls, cross-sections through each contact, and views.json.
+    Render(RenderArgs),
+}
+
+#[derive(Args)]
+struct RenderArgs {
+    /// A scene (sample folder, scene.json, mesh file) or an export output folder.
+    path: PathBuf,
+    /// Output folder (replaced atomically).
+    #[arg(short, long)]
+    out: PathBuf,
+    #[command(flatten)]
+    render: RenderOpts,
+    #[command(flatten)]
+    build: BuildArgs,
+    #[command(flatten)]
+    limits: LimitsArgs,
+    /// Replace OUT even if it is not an earlier render.
+    #[arg(long)]
+    force: bool,
+}
+
+/// Picture sizes (for `render`, and for `--render` of export, validate and batch).
+#[derive(Args, Clone)]
+struct RenderOpts {
+    /// Width and height of each view, pixels.
+    #[arg(long, default_value_t = 512)]
+    image_size: u32,
+    /// Width and height of each cross-section, pixels.
+    #[arg(long, default_value_t = 512)]
+    section_size: u32,
+}
+
+impl RenderOpts {
+    fn options(&self) -> interact3d::render::RenderOptions {
+        interact3d::render::RenderOptions {
+            size: self.image_size,
+            section_size: self.section_size,
+            ..Default::default()
+        }
+    }
 }
 
 #[derive(Args)]
@@ -55,6 +97,14 @@ struct ComposeArgs {
     /// Replace OUT even if it is not an earlier interact3d output.
     #[arg(long)]
     force: bool,
+    /// While the composition penetrates (pair penetration > 1 % of the smaller object), run
+    /// this shell command with a JSON attempt on stdin; its stdout JSON names replacement
+    /// meshes; recompose (see docs/render.md).
+    #[arg(long, value_name = "CMD")]
+    agent: Option<String>,
+    /// Most calls of the --agent command.
+    #[arg(long, default_value_t = 5, requires = "agent")]
+    max_iterations: usize,
 }
 
 #[derive(Args, Clone)]
@@ -167,6 +217,12 @@ struct ValidateArgs {
     /// Write JUnit XML (one test case per check) to this file.
     #[arg(long, value_name = "FILE")]
     junit: Option<PathBuf>,
+    /// Also draw the scene into this folder (views, hull views, cross-sections, and
+    /// index.html with the metrics and findings).
+    #[arg(long, value_name = "DIR")]
+    render: Option<PathBuf>,
+    #[command(flatten)]
+    render_opts: RenderOpts,
 }
 
 #[derive(Args)]
@@ -239,6 +295,11 @@ struct ExportArgs {
     /// Write JUnit XML of the validation to this file.
     #[arg(long, value_name = "FILE")]
     junit: Option<PathBuf>,
+    /// Also draw the scene into OUT/render/ (views, hull views, cross-sections, index.html).
+    #[arg(long)]
+    render: bool,
+    #[command(flatten)]
+    render_opts: RenderOpts,
 }
 
 #[derive(Args)]
@@ -294,6 +355,12 @@ struct BatchArgs {
     keep_composed_pose: bool,
     #[command(flatten)]
     check: CheckArgs,
+    /// Draw every scene into OUT/<scene>/render/; index.html then shows a thumbnail per scene
+    /// linking to the scene's page.
+    #[arg(long)]
+    render: bool,
+    #[command(flatten)]
+    render_opts: RenderOpts,
 }
 
 #[derive(Clone, Copy, clap::ValueEnum)]
@@ -399,6 +466,7 @@ fn run(cli: Cli) -> Result<ExitCode, Error> {
                 validate: (!a.no_validate).then(|| a.check.options()),
                 keep_composed_pose: a.keep_composed_pose,
                 fix_penetration: a.fix_penetration,
+                render: a.render.then(|| a.render_opts.options()),
             };
             let t = std::time::Instant::now();
             let done = interact3d::pipeline::export_scene(&a.scene, &a.out, &job)?;
@@ -448,6 +516,28 @@ fn run(cli: Cli) -> Result<ExitCode, Error> {
             Ok(code)
         }
         Command::Batch(a) => batch(a),
+        Command::Render(a) => {
+            let t = std::time::Instant::now();
+            let assembly =
+                interact3d::pipeline::load_any(&a.path, &a.limits.limits(), &a.build.options())?;
+            let t_draw = std::time::Instant::now();
+            let r = interact3d::render::render_to_dir(
+                &assembly,
+                &a.out,
+                &a.render.options(),
+                None,
+                a.force,
+            )?;
+            eprintln!(
+                "rendered {} pictures of {} into {} in {:.2} s (loading {:.2} s)",
+                r.pictures.len(),
+                assembly.name,
+                a.out.display(),
+                t_draw.elapsed().as_secs_f64(),
+                (t_draw - t).as_secs_f64()
+            );
+            Ok(ExitCode::SUCCESS)
+        }
         Command::Compose(a) => {
             let t = std::time::Instant::now();
             let opts = interact3d::compose::ComposeOptions {
@@ -456,6 +546,31 @@ fn run(cli: Cli) -> Result<ExitCode, Error> {
                 anchor: a.anchor,
                 ..Default::default()
             };
+            if let Some(cmd) = &a.agent {
+                let mut ao = interact3d::compose::agent::AgentOptions::new(cmd.clone());
+                ao.max_iterations = a.max_iterations;
+                let r = interact3d::compose::agent::compose_with_agent(
+                    &a.sample,
+                    &a.out,
+                    &opts,
+                    &Default::default(),
+                    a.force,
+                    &ao,
+                )?;
+                eprintln!(
+                    "composed into {} with {} agent call(s) in {:.2} s: penetration ratio {:.2e} ({})",
+                    a.out.display(),
+                    r.iterations,
+                    t.elapsed().as_secs_f64(),
+                    r.ratio,
+                    if r.success { "success" } else { "still above the threshold" }
+                );
+                return Ok(if r.success {
+                    ExitCode::SUCCESS
+                } else {
+                    ExitCode::from(1)
+                });
+            }
             let (comp, check) = interact3d::compose::folder::compose_folder(
                 &a.sample,
                 &a.out,
@@ -522,6 +637,17 @@ fn validate(a: ValidateArgs) -> Result<ExitCode, Error> {
                     f,
                     interact3d::validate::junit(&assembly.name, &v).as_bytes(),
                 )?;
+            }
+            if let Some(dir) = &a.render {
+                let json = serde_json::to_value(&v).map_err(|e| Error::Internal(e.to_string()))?;
+                interact3d::render::render_to_dir(
+                    &assembly,
+                    dir,
+                    &a.render_opts.options(),
+                    Some(&json),
+                    false,
+                )?;
+                eprintln!("pictures: {}", dir.join("index.html").display());
             }
             return Ok(if v.passed {
                 ExitCode::SUCCESS
@@ -613,6 +739,7 @@ fn batch(a: BatchArgs) -> Result<ExitCode, Error> {
         },
         validate: Some(a.check.options()),
         keep_composed_pose: a.keep_composed_pose,
+        render: a.render.then(|| a.render_opts.options()),
         ..Default::default()
     };
     let mut opts = batch::BatchOptions::new(root, &a.out, job);

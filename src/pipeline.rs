@@ -23,6 +23,8 @@ pub struct ExportJob {
     /// Remove slight interpenetration of the given poses first (`--fix-penetration`: the
     /// collision-aware refinement of `compose`, moving each object as little as possible).
     pub fix_penetration: bool,
+    /// Draw the scene into `OUT/render/` (`--render`; see [`crate::render`]).
+    pub render: Option<crate::render::RenderOptions>,
 }
 
 /// Load a scene (sample folder or manifest) and build its bodies.
@@ -35,6 +37,8 @@ pub fn load_assembly(scene: &Path, limits: &Limits, opts: &BuildOptions) -> Resu
 pub struct Exported {
     pub report: Report,
     pub validation: Option<Validation>,
+    /// Pictures drawn into `OUT/render/` (with `ExportJob::render`).
+    pub rendered: bool,
 }
 
 /// Export a scene to `out`, validating it first unless told not to; returns what was written.
@@ -67,7 +71,20 @@ pub fn export_scene(scene: &Path, out: &Path, job: &ExportJob) -> Result<Exporte
         None => None,
     };
     export(&assembly, &report, out, &job.export)?;
-    Ok(Exported { report, validation })
+    if let Some(ro) = &job.render {
+        crate::render::render_to_dir(
+            &assembly,
+            &out.join("render"),
+            ro,
+            report.validation.as_ref(),
+            true,
+        )?;
+    }
+    Ok(Exported {
+        report,
+        validation,
+        rendered: job.render.is_some(),
+    })
 }
 
 /// Validate a scene, or an export folder (its hulls and inertials as written, from its initial
@@ -78,11 +95,16 @@ pub fn validate_path(
     build: &BuildOptions,
     opts: &ValidateOptions,
 ) -> Result<(Assembly, Validation)> {
-    let assembly = if crate::export::read::is_export(path) {
-        crate::export::read::load(path, limits)?
-    } else {
-        load_assembly(path, limits, build)?
-    };
+    let assembly = load_any(path, limits, build)?;
     let v = validate(&assembly, opts)?;
     Ok((assembly, v))
+}
+
+/// An export folder's bodies as written, or a scene's bodies built afresh.
+pub fn load_any(path: &Path, limits: &Limits, build: &BuildOptions) -> Result<Assembly> {
+    if crate::export::read::is_export(path) {
+        crate::export::read::load(path, limits)
+    } else {
+        load_assembly(path, limits, build)
+    }
 }

@@ -1,7 +1,9 @@
 //! `OUT/index.html`: one self-contained page (inline CSS and JavaScript, no network) to browse a
 //! batch: counts, a sortable table, filters by verdict and category, a text filter, and links to
-//! each scene's files. The time column shows conversion times; a scene reused from an earlier
-//! run says "reused" (the run only checked its hash). Entry point: [`page`].
+//! each scene's files; with `--render`, a thumbnail per scene linking to its page
+//! (`<scene>/render/index.html`, see [`crate::render::page`]). The time column shows conversion
+//! times; a scene reused from an earlier run says "reused" (the run only checked its hash).
+//! Entry point: [`page`].
 
 use super::summary::Summary;
 use crate::error::{Error, Result};
@@ -14,7 +16,9 @@ pub fn page(summary: &Summary) -> Result<String> {
         .replace('<', "\\u003c")
         .replace('>', "\\u003e")
         .replace('&', "\\u0026");
-    Ok(TEMPLATE.replace("/*DATA*/null", &data))
+    Ok(TEMPLATE
+        .replace("/*SELFCHECK*/", crate::render::page::SELFCHECK_JS)
+        .replace("/*DATA*/null", &data))
 }
 
 const TEMPLATE: &str = r##"<!DOCTYPE html>
@@ -50,17 +54,20 @@ a { color: #1d4ed8; }
   <label>verdict <select id="verdict"><option value="">all</option><option>pass</option><option>fail</option><option>error</option></select></label>
   <label>category <select id="category"><option value="">all</option></select></label>
   <label>path contains <input id="text" type="search" size="24"></label>
+  <label>metric <select id="metric"></select> &ge; <input id="min" type="number" step="any" size="8"></label>
   <span id="shown"></span>
 </div>
 <table>
 <thead><tr id="head"></tr></thead>
 <tbody id="rows"></tbody>
 </table>
+<div id="selfcheck" style="color:#888;font-size:.8em;margin-top:2em">self-check: not run</div>
 <script>
+/*SELFCHECK*/
 "use strict";
 const DATA = /*DATA*/null;
 const COLS = [
-  ["path", "scene", "text"], ["category", "category", "text"], ["objects", "objects", "num"],
+  ["rendered", "view", "thumb"], ["path", "scene", "text"], ["category", "category", "text"], ["objects", "objects", "num"],
   ["verdict", "verdict", "text"], ["r_volume", "R_volume", "num"],
   ["max_penetration_m", "max penetration (mm)", "mm"], ["collision_penetration_m", "hull penetration (mm)", "mm"],
   ["max_displacement_m", "max displacement (mm)", "mm"], ["hulls", "hulls", "list"],
@@ -96,10 +103,21 @@ function render() {
   const v = document.getElementById("verdict").value;
   const c = document.getElementById("category").value;
   const t = document.getElementById("text").value.toLowerCase();
+  const mk = document.getElementById("metric").value;
+  const mc = COLS.find(x => x[0] === mk);
+  const minRaw = document.getElementById("min").value;
+  const min = minRaw === "" ? null : Number(minRaw) / (mc && mc[2] === "mm" ? 1000 : 1);
   const rows = DATA.scenes.filter(r => (!v || r.verdict === v) && (!c || r.category === c)
-    && (!t || r.path.toLowerCase().includes(t))).sort(cmp);
+    && (!t || r.path.toLowerCase().includes(t))
+    && (min === null || (value(r, mk) !== null && value(r, mk) !== undefined && value(r, mk) >= min))).sort(cmp);
   const body = document.getElementById("rows");
   body.replaceChildren(...rows.map(r => el("tr", {}, COLS.map(([key, , kind]) => {
+    if (kind === "thumb") {
+      if (!r.rendered) return el("td");
+      const base = r.path.split("/").map(encodeURIComponent).join("/") + "/render/";
+      return el("td", {}, [el("a", { href: base + "index.html" }, [el("img", {
+        src: base + "views/three_quarter.png", width: 96, height: 96, alt: r.path })])]);
+    }
     if (kind === "files") {
       if (r.verdict === "error") return el("td");
       const base = r.path.split("/").map(encodeURIComponent).join("/") + "/";
@@ -131,14 +149,16 @@ document.getElementById("category").append(...cats.map(c => el("option", { value
 document.getElementById("head").append(...COLS.map(([key, label, kind]) => {
   const th = el("th", { textContent: label });
   th.dataset.key = key;
-  if (kind !== "files") th.onclick = () => {
+  if (kind !== "files" && kind !== "thumb") th.onclick = () => {
     sortDir = sortKey === key ? -sortDir : 1;
     sortKey = key;
     render();
   };
   return th;
 }));
-["verdict", "category", "text"].forEach(id => document.getElementById(id).addEventListener("input", render));
+document.getElementById("metric").append(...COLS.filter(c => c[2] === "num" || c[2] === "mm")
+  .map(([key, label]) => el("option", { value: key, textContent: label })));
+["verdict", "category", "text", "metric", "min"].forEach(id => document.getElementById(id).addEventListener("input", render));
 render();
 </script>
 </body>

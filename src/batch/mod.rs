@@ -332,13 +332,14 @@ impl Ctx<'_> {
         }
         let stage = self.staging.join(format!("{index:07}"));
         let exported = (self.worker)(e, &stage, self.job)?;
-        let result = SceneResult::from_export(
+        let mut result = SceneResult::from_export(
             &e.rel,
             e.id(),
             e.category(),
             &exported.report,
             exported.validation.as_ref(),
         );
+        result.rendered = exported.rendered;
         drop(exported);
         let record = SceneRecord {
             tool: "interact3d".into(),

@@ -54,6 +54,9 @@ pub struct SceneResult {
     pub hulls: Vec<usize>,
     /// Failed checks as `name subject`.
     pub failed_checks: Vec<String>,
+    /// Pictures were drawn into the scene's `render/` folder (`--render`).
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub rendered: bool,
 }
 
 /// One line of the summary.
@@ -130,6 +133,7 @@ impl SceneResult {
             max_displacement_m: None,
             hulls: Vec::new(),
             failed_checks: Vec::new(),
+            rendered: false,
         }
     }
 }

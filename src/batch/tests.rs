@@ -45,6 +45,7 @@ fn worker(
         Ok(Exported {
             report: fake_report(e.name()),
             validation: None,
+            rendered: false,
         })
     }
 }

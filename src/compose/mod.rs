@@ -17,6 +17,7 @@
 //! Everything is deterministic for a seed. [`synth`] makes guidance parts from ground-truth
 //! scenes for tests and the benchmark; [`folder`] reads sample folders and writes the output.
 
+pub mod agent;
 pub mod cloud;
 pub mod colour;
 pub mod features;
