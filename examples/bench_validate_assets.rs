@@ -2,6 +2,7 @@
 //! same files. A table on stdout.
 //!
 //! usage: cargo run --release --example bench_validate_assets -- [--n 100] [--simcheck BIN]
+//!        [--simcheck-n K]
 //!
 //! The assets: pybullet_data's duck_vhacd, teddy_vhacd, cube_small, sphere2 and tray/traybox
 //! (found through `python3 -c "import pybullet_data"`), every YCB URDF and every Google Scanned
@@ -28,6 +29,10 @@ fn main() {
     };
     let n: usize = arg("--n").map(|s| s.parse().unwrap()).unwrap_or(100);
     let simcheck = arg("--simcheck");
+    // simcheck takes seconds a file: time it on the first K distinct files only.
+    let simcheck_n: usize = arg("--simcheck-n")
+        .map(|s| s.parse().unwrap())
+        .unwrap_or(usize::MAX);
     let py = std::env::var("INTERACT3D_PYTHON").unwrap_or_else(|_| "python3".into());
     let out = std::process::Command::new(&py)
         .args([
@@ -53,6 +58,7 @@ fn main() {
             .unwrap()
             .flatten()
             .map(|e| e.path())
+            .filter(|p| p.is_dir())
             .collect();
         dirs.sort();
         for d in dirs {
@@ -110,7 +116,7 @@ fn main() {
     if let Some(bin) = simcheck {
         let mut st = Vec::new();
         let mut codes = std::collections::BTreeMap::new();
-        for f in &files {
+        for f in files.iter().take(simcheck_n) {
             let t = Instant::now();
             let o = std::process::Command::new(&bin)
                 .arg("check")
@@ -123,8 +129,8 @@ fn main() {
         let (m, w) = stats(&st);
         println!(
             "| simcheck check | {} | {} | {m:.3} | {w:.3} | {:.2} (sequential) |",
-            files.len(),
-            files.len(),
+            st.len(),
+            st.len(),
             st.iter().sum::<f64>()
         );
         eprintln!("simcheck exit codes: {codes:?}");
