@@ -215,25 +215,6 @@ pub struct ReadOptions {
     pub packages: Vec<(String, PathBuf)>,
 }
 
-/// Whether a file looks like a URDF or MJCF asset (by extension and root element).
-pub fn is_asset(path: &Path) -> bool {
-    let ext = path
-        .extension()
-        .and_then(|e| e.to_str())
-        .map(|e| e.to_ascii_lowercase())
-        .unwrap_or_default();
-    match ext.as_str() {
-        "urdf" | "mjcf" => true,
-        "xml" => std::fs::read(path)
-            .map(|b| {
-                let head = String::from_utf8_lossy(&b[..b.len().min(4096)]).to_string();
-                head.contains("<mujoco") || head.contains("<robot")
-            })
-            .unwrap_or(false),
-        _ => false,
-    }
-}
-
 /// Read a URDF or MJCF file.
 pub fn load(path: &Path, opts: &ReadOptions) -> Result<Asset> {
     let root = crate::io::xml::parse_file(path, &opts.limits)?;

@@ -14,7 +14,7 @@
 //! A body without joints is welded to its parent: under the world it is fixed, under another
 //! body it is merged into that body. A plane on the world body is the floor.
 
-use crate::error::{Error, Result};
+use crate::error::Result;
 use crate::io::asset::{
     combine, floats, mesh_pieces, Asset, AssetBody, AuthoredInertial, Geom, ReadIssue, ReadOptions,
     Shape, Source,
@@ -88,9 +88,6 @@ fn with_defaults(e: &Element, class: &str, defaults: &Defaults) -> Element {
         if chain.len() > 64 {
             break;
         }
-    }
-    if class != "main" && !chain.is_empty() && !defaults.contains_key("main") {
-        // no top-level default: nothing more
     }
     let mut out = e.clone();
     for attrs in chain.iter() {
@@ -537,7 +534,7 @@ pub fn read(path: &Path, root: &Element, opts: &ReadOptions) -> Result<Asset> {
                 None => parts.extend(crate::io::asset::geometric_inertial(&tmp)),
             }
             geoms.extend(own);
-            if f.group != gi || !std::ptr::eq(f, &flats[gi]) {
+            if !std::ptr::eq(f, &flats[gi]) {
                 merged.push(f.name.clone());
             }
         }
@@ -584,13 +581,12 @@ fn walk(
     flats: &mut Vec<Flat>,
     nq: &mut usize,
 ) -> Result<()> {
-    let b_def = b;
     let childclass = b.attr("childclass").unwrap_or(class).to_string();
     let name = b
         .attr("name")
         .map(str::to_string)
         .unwrap_or_else(|| format!("body@{}", b.line));
-    let world = parent * frame(b_def, &ctx.c)?;
+    let world = parent * frame(b, &ctx.c)?;
     let mut free = false;
     let mut qpos = None;
     let mut moving = None;
@@ -689,6 +685,3 @@ fn walk(
     }
     Ok(())
 }
-
-#[allow(dead_code)]
-fn unused(_: Error) {}
