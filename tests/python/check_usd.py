@@ -241,7 +241,7 @@ def run_physx(out, seconds, dt):
         bodies[p] = {
             "moved_m": float(np.linalg.norm(np.array(e["position"]) - np.array(s["position"]))),
             "turned_deg": quat_angle_deg(q0, q1),
-            "mass": float(np.ravel(s.get("mass", [float("nan")]))[0]),
+            "mass": float(np.ravel(s["mass"])[0]) if "mass" in s else None,
             "finite": bool(np.all(np.isfinite(e["position"])) and np.all(np.isfinite(e["orientation"]))),
         }
     cooked = np.unique(np.concatenate(lines), axis=0) if lines else np.zeros((0, 3))
@@ -263,10 +263,10 @@ def compare_cooked(hulls, cooked):
             d = np.full(len(pts), np.inf)
         else:
             d = np.min(np.linalg.norm(pts[:, None, :] - near[None, :, :], axis=2), axis=1)
-        worst_authored = max(worst_authored, float(d.max()))
+        worst_authored = max(worst_authored, float(d.max()) if np.all(np.isfinite(d)) else 1e9)
         if len(near):
             dc = np.min(np.linalg.norm(near[:, None, :] - pts[None, :, :], axis=2), axis=1)
-            mine = near[dc <= 1e-6]
+            mine = near[dc <= 1e-3]  # PhysX may shift a vertex by its plane tolerance
         else:
             mine = near
         try:
@@ -274,8 +274,8 @@ def compare_cooked(hulls, cooked):
 
             eq = ConvexHull(mine).equations
             dev = float(max(0.0, np.max(pts @ eq[:, :3].T + eq[:, 3])))
-        except Exception:
-            dev = float("inf")
+        except Exception:  # qhull refuses a flat or tiny cooked set: tests/usd.rs measures it
+            dev = None
         per_hull.append(
             {
                 "path": path,
@@ -283,7 +283,7 @@ def compare_cooked(hulls, cooked):
                 # distance; tests/usd.rs measures it exactly).
                 "deviation_m": dev,
                 "vertices": int(len(pts)),
-                "max_unmatched_m": float(d.max()),
+                "max_unmatched_m": float(d.max()) if np.all(np.isfinite(d)) else None,
                 # World frame: the authored points, and the cooked vertices that are among them.
                 "authored": pts.tolist(),
                 "cooked": mine.tolist(),
@@ -293,7 +293,7 @@ def compare_cooked(hulls, cooked):
         dc = np.min(np.linalg.norm(near[:, None, :] - authored[None, :, :], axis=2), axis=1)
         worst_cooked = float(dc.max())
     else:
-        worst_cooked = float("inf")
+        worst_cooked = None
     return {
         "hulls": len(hulls),
         "cooked_vertices": int(len(near)),
@@ -301,8 +301,8 @@ def compare_cooked(hulls, cooked):
         # Farthest authored hull vertex from any cooked vertex, and the other way round.
         "authored_to_cooked_max_m": worst_authored,
         "cooked_to_authored_max_m": worst_cooked,
-        "changed_hulls": [h["path"] for h in per_hull if h["deviation_m"] > 1e-4],
-        "deviation_max_m": max(h["deviation_m"] for h in per_hull),
+        "changed_hulls": [h["path"] for h in per_hull if (h["deviation_m"] or 0.0) > 1e-4],
+        "deviation_max_m": max((h["deviation_m"] or 0.0) for h in per_hull),
         "per_hull": per_hull,
     }
 
@@ -355,7 +355,7 @@ def main():
             result["physx"] = r
         if newton:
             result["newton"] = run_newton(out)
-    json.dump(result, sys.stdout, indent=1, sort_keys=True)
+    json.dump(result, sys.stdout, indent=1, sort_keys=True, allow_nan=False)
     sys.stdout.write("\n")
 
 
