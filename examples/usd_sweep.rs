@@ -73,10 +73,12 @@ fn sweep_scenes(python: &str) {
         let tmp = tempfile::tempdir().unwrap();
         let out = tmp.path().join("out");
         let t = Instant::now();
-        let job = interact3d::pipeline::ExportJob {
+        let mut job = interact3d::pipeline::ExportJob {
             validate: Some(Default::default()),
             ..Default::default()
         };
+        // For Isaac: every hull within PhysX's polygon budget (`--max-hull-polygons 64`).
+        job.build.decompose.max_polygons = interact3d::decompose::PHYSX_MAX_POLYGONS;
         let exported = match interact3d::pipeline::export_scene(&scene, &out, &job) {
             Ok(e) => e,
             Err(e) => {
@@ -198,7 +200,13 @@ fn sweep_objects() {
             .max()
             .unwrap_or(0);
         let t = Instant::now();
-        physx_legal(&mut sets, &DecomposeOptions::default());
+        physx_legal(
+            &mut sets,
+            &DecomposeOptions {
+                max_polygons: interact3d::decompose::PHYSX_MAX_POLYGONS,
+                ..Default::default()
+            },
+        );
         let ms = t.elapsed().as_secs_f64() * 1e3;
         let q0 = metrics::measure(&m, &before);
         let q1 = metrics::measure(&m, &sets[0]);

@@ -250,9 +250,10 @@ struct BuildArgs {
     /// Most vertices per hull (PhysX/Isaac accept 64).
     #[arg(long, default_value_t = 64)]
     max_hull_vertices: usize,
-    /// Most polygons per hull (coplanar triangles merged). PhysX cooks a hull of more than 64
-    /// into another shape, silently; 0: no limit (MuJoCo-only exports keep rounder hulls).
-    #[arg(long, value_name = "N", default_value_t = interact3d::decompose::DEFAULT_MAX_POLYGONS)]
+    /// Most polygons per hull (coplanar triangles merged); 0: no limit. PhysX (Isaac) re-cooks
+    /// a hull of more than 64 into another shape, silently: give 64 when exporting for Isaac
+    /// (it costs fidelity on round objects, see docs/usd.md).
+    #[arg(long, value_name = "N", default_value_t = 0)]
     max_hull_polygons: usize,
     /// V-HACD voxel resolution.
     #[arg(long, default_value_t = 64)]
