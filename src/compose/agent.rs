@@ -113,7 +113,9 @@ fn penetration_ratio(composed: &Path, check: &Value, limits: &Limits) -> Result<
         scene
             .objects
             .iter()
-            .find(|o| o.name == name)
+            // The check names objects by their file ids (`object_b`); the composed scene.json
+            // by their labels (`ball`), with the ids as aliases.
+            .find(|o| o.name == name || o.aliases.iter().any(|a| a == name))
             .and_then(|o| o.visual.geometry().transformed(&o.pose.matrix()).aabb())
             .map(|b| b.diagonal())
             .unwrap_or(f64::NAN)
@@ -124,7 +126,14 @@ fn penetration_ratio(composed: &Path, check: &Value, limits: &Limits) -> Result<
             continue;
         };
         let d = p["max_penetration_depth"].as_f64().unwrap_or(0.0);
-        let scale = diag(a).min(diag(b));
+        let (da, db) = (diag(a), diag(b));
+        let scale = da.min(db);
+        if da.is_nan() || db.is_nan() {
+            return Err(crate::Error::Internal(format!(
+                "the penetration check names {a:?} and {b:?}, not both objects of {}",
+                composed.display()
+            )));
+        }
         if d > 0.0 && scale > 0.0 {
             worst = worst.max(d / scale);
         }
