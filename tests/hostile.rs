@@ -1273,10 +1273,12 @@ fn free_text_from_inputs_is_escaped_in_xml() {
         names,
         [
             "box.urdf",
+            "box.usda",
             "box.xml",
             "meshes",
             "report.json",
             "scene.json",
+            "scene.usda",
             "scene.xml"
         ]
     );

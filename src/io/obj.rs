@@ -9,6 +9,14 @@ use std::path::Path;
 
 /// Load an OBJ file with its MTL library and textures. The MTL and textures must lie inside the
 /// OBJ's own folder (or below it); a missing MTL or texture is an error naming it.
+/// How tobj reads every OBJ here: triangles with one index per corner, points and lines left out.
+const LOAD_OPTIONS: tobj::LoadOptions = tobj::LoadOptions {
+    triangulate: true,
+    single_index: true,
+    ignore_points: true,
+    ignore_lines: true,
+};
+
 pub fn load(path: &Path, limits: &Limits) -> Result<VisualMesh> {
     let root = path.parent().unwrap_or(Path::new("."));
     load_in(path, root, limits)
@@ -26,12 +34,7 @@ pub fn load_bytes(path: &Path, bytes: &[u8], root: &Path, limits: &Limits) -> Re
     let text = String::from_utf8_lossy(bytes);
     // tobj silently drops out-of-range indices and treats 0 as valid; check indices ourselves.
     check_indices(path, &text)?;
-    let opts = tobj::LoadOptions {
-        triangulate: true,
-        single_index: true,
-        ignore_points: true,
-        ignore_lines: true,
-    };
+    let opts = LOAD_OPTIONS;
     let mtl_error: std::cell::RefCell<Option<Error>> = std::cell::RefCell::new(None);
     let (models, materials) = tobj::load_obj_buf(&mut &bytes[..], &opts, |mtl| {
         let name = mtl.to_string_lossy();
@@ -189,12 +192,7 @@ fn check_indices(path: &Path, text: &str) -> Result<()> {
 pub fn load_geometry_bytes(path: &Path, bytes: &[u8], limits: &Limits) -> Result<VisualMesh> {
     let text = String::from_utf8_lossy(bytes);
     check_indices(path, &text)?;
-    let opts = tobj::LoadOptions {
-        triangulate: true,
-        single_index: true,
-        ignore_points: true,
-        ignore_lines: true,
-    };
+    let opts = LOAD_OPTIONS;
     let (models, _) = tobj::load_obj_buf(&mut &bytes[..], &opts, |_| {
         Err(tobj::LoadError::OpenFileFailed)
     })

@@ -50,8 +50,11 @@ pub fn is_model_file(p: &Path) -> bool {
     }
 }
 
+/// A scene folder as `batch` finds them (a `scene.json`, or a sample folder's `metadata.json`),
+/// or a folder of `object_*.glb`: its own reader then names what is wrong with it.
 fn is_scene_dir(d: &Path) -> bool {
     d.join("scene.json").is_file()
+        || d.join("metadata.json").is_file()
         || std::fs::read_dir(d)
             .map(|it| {
                 it.flatten().any(|e| {
