@@ -60,15 +60,7 @@ fn close(a: &[f64], b: &[f64], tol: f64) -> bool {
 
 /// Export with the binary; (exit code, stderr, report.json).
 fn export_with(scene: &Path, out: &Path, extra: &[&str]) -> (i32, String, Value) {
-    let mut args = vec![
-        "export",
-        scene.to_str().unwrap(),
-        "-o",
-        out.to_str().unwrap(),
-    ];
-    args.extend_from_slice(extra);
-    let (code, _, err) = run(&args);
-    assert!(code == 0 || code == 1, "export failed: {err}");
+    let (code, err) = common::export_logged(scene, out, extra);
     (code, err, read_json(&out.join("report.json")))
 }
 

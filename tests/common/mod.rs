@@ -32,6 +32,11 @@ pub fn run(args: &[&str]) -> (i32, String, String) {
 /// written (exit 0, or 1 when the scene failed validation: it is exported all the same).
 /// Returns the exit code.
 pub fn export(scene: &Path, out: &Path, extra: &[&str]) -> i32 {
+    export_logged(scene, out, extra).0
+}
+
+/// [`export`], returning the exit code and the command's stderr.
+pub fn export_logged(scene: &Path, out: &Path, extra: &[&str]) -> (i32, String) {
     let mut args = vec![
         "export",
         scene.to_str().unwrap(),
@@ -50,7 +55,7 @@ pub fn export(scene: &Path, out: &Path, extra: &[&str]) -> i32 {
         "export {} wrote no report: {err}",
         scene.display()
     );
-    code
+    (code, err)
 }
 
 /// The Python interpreter for the interoperability tests.
