@@ -329,15 +329,7 @@ fn shards_cover_every_scene_exactly_once_and_merge_back() {
             .collect()
     };
     let (a, b) = (files(&single), files(&out));
-    assert_eq!(
-        a.iter().map(|x| &x.0).collect::<Vec<_>>(),
-        b.iter().map(|x| &x.0).collect::<Vec<_>>(),
-        "same files"
-    );
-    assert!(a.len() > 30);
-    for (x, y) in a.iter().zip(&b) {
-        assert!(x.1 == y.1, "{} differs", x.0);
-    }
+    assert_same_files(&a, &b);
     let merged = read_json(&out.join("summary.json"));
     assert_eq!(merged["counts"]["scenes"], made.len());
     assert_eq!(
@@ -489,15 +481,7 @@ fn a_run_killed_midway_then_resumed_equals_one_clean_run() {
             .collect()
     };
     let (a, b) = (files(&clean), files(&killed));
-    assert_eq!(
-        a.iter().map(|x| &x.0).collect::<Vec<_>>(),
-        b.iter().map(|x| &x.0).collect::<Vec<_>>(),
-        "same files"
-    );
-    assert!(a.len() > 30);
-    for (x, y) in a.iter().zip(&b) {
-        assert!(x.1 == y.1, "{} differs", x.0);
-    }
+    assert_same_files(&a, &b);
     assert_eq!(
         stable(read_json(&clean.join("summary.json"))),
         stable(read_json(&killed.join("summary.json")))
@@ -558,4 +542,17 @@ fn filters_and_usage_errors() {
     assert_eq!(code, 2);
     assert!(err.contains("--resume"), "{err}");
     assert!(!t.path().join("fresh").exists());
+}
+
+/// Two snapshots hold the same file names (more than 30 of them) with the same bytes.
+fn assert_same_files(a: &[(String, Vec<u8>)], b: &[(String, Vec<u8>)]) {
+    assert_eq!(
+        a.iter().map(|x| &x.0).collect::<Vec<_>>(),
+        b.iter().map(|x| &x.0).collect::<Vec<_>>(),
+        "same files"
+    );
+    assert!(a.len() > 30);
+    for (x, y) in a.iter().zip(b) {
+        assert!(x.1 == y.1, "{} differs", x.0);
+    }
 }

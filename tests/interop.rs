@@ -196,14 +196,18 @@ fn real_scans_load_in_mujoco_and_pybullet() {
     }
 }
 
-/// A quaternion from four JSON numbers in the order given (`wxyz` true: scalar first).
-fn quat(v: &serde_json::Value, wxyz: bool) -> nalgebra::UnitQuaternion<f64> {
-    let a: Vec<f64> = v
-        .as_array()
+/// A JSON array of numbers.
+fn numbers(v: &serde_json::Value) -> Vec<f64> {
+    v.as_array()
         .unwrap()
         .iter()
         .map(|x| x.as_f64().unwrap())
-        .collect();
+        .collect()
+}
+
+/// A quaternion from four JSON numbers in the order given (`wxyz` true: scalar first).
+fn quat(v: &serde_json::Value, wxyz: bool) -> nalgebra::UnitQuaternion<f64> {
+    let a = numbers(v);
     let q = if wxyz {
         nalgebra::Quaternion::new(a[0], a[1], a[2], a[3])
     } else {
@@ -213,12 +217,7 @@ fn quat(v: &serde_json::Value, wxyz: bool) -> nalgebra::UnitQuaternion<f64> {
 }
 
 fn vec3(v: &serde_json::Value) -> nalgebra::Vector3<f64> {
-    let a: Vec<f64> = v
-        .as_array()
-        .unwrap()
-        .iter()
-        .map(|x| x.as_f64().unwrap())
-        .collect();
+    let a = numbers(v);
     nalgebra::Vector3::new(a[0], a[1], a[2])
 }
 
