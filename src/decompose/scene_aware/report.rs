@@ -60,6 +60,10 @@ pub struct ObjectReport {
     pub lossy_cuts: usize,
     /// Hulls dropped because a cut left them thinner than `min_thickness`.
     pub dropped_hulls: usize,
+    /// Hulls a cut would have left too thin, built again from what the cut leaves of their
+    /// patch (see `fit::kept_side`).
+    #[serde(default)]
+    pub rebuilt_hulls: usize,
     /// Sampled one-sided distance from the hull surfaces to the mesh, 95th percentile and
     /// maximum, relative to the bounding-box diagonal (what the engine chooses by; the
     /// two-sided figures and their warning are `body::assemble`'s, for every engine).
