@@ -1,6 +1,7 @@
 //! Bodies: what a simulator gets for each object. The frame of a body is at its centre of mass
 //! with world-aligned axes at the composed pose; visual and collision geometry are expressed in it.
 
+use crate::decompose::scene_aware::metrics::{self, TwoSided};
 use crate::decompose::{scene_aware::SceneAware, vhacd::Vhacd, DecomposeOptions, Decomposer, Hull};
 use crate::error::{Error, Result};
 use crate::inertia::{self, Inertial, DEFAULT_DENSITY};
@@ -41,6 +42,10 @@ pub struct Body {
     pub fixed: bool,
     pub closed: bool,
     pub warnings: Vec<String>,
+    /// How close the collision hulls lie to the mesh, both ways (see
+    /// `decompose::scene_aware::metrics::two_sided`); `None` when not measured (an export
+    /// folder read back).
+    pub fidelity: Option<TwoSided>,
 }
 
 impl Body {
@@ -159,6 +164,16 @@ pub fn assemble(
                 ),
             ));
         }
+        // Both directions, for every engine; the warning reads the headline figure.
+        let fidelity = metrics::two_sided_of(&o.geometry, &hulls);
+        if let Some(f) = &fidelity {
+            warnings.extend(metrics::tolerance_warning(
+                f,
+                dopts.tolerance,
+                hulls.len(),
+                dopts.max_hulls,
+            ));
+        }
         let mut inertial = None;
         if o.closed {
             let m = inertia::of_closed_mesh(&o.geometry, density);
@@ -225,6 +240,7 @@ pub fn assemble(
             fixed: o.physical.fixed,
             closed: o.closed,
             warnings,
+            fidelity,
         });
     }
     Ok(Assembly {

@@ -477,8 +477,19 @@ fn run(cli: Cli) -> Result<ExitCode, Error> {
             let done = interact3d::pipeline::export_scene(&a.scene, &a.out, &job)?;
             let report = &done.report;
             for o in &report.objects {
+                // Collision fit, % of the bbox diagonal: two-sided p95 (hulls→mesh,
+                // mesh→hulls) and the mesh's outside depth at p99.
+                let fit = o.collision_fit.map_or(String::new(), |f| {
+                    format!(
+                        "fit p95 {:>5.2} % ({:.2}/{:.2})  outside p99 {:>4.2} %  ",
+                        f.p95 * 100.0,
+                        f.hull_to_mesh_p95 * 100.0,
+                        f.mesh_to_hull_p95 * 100.0,
+                        f.outside_p99 * 100.0
+                    )
+                });
                 eprintln!(
-                    "{:<16} mass {:>9.4} kg  hulls {:>3}  max verts {:>3}  {}",
+                    "{:<16} mass {:>9.4} kg  hulls {:>3}  max verts {:>3}  {fit}{}",
                     o.name,
                     o.mass,
                     o.hull_count,

@@ -5,6 +5,7 @@
 //! under their table).
 
 use crate::body::Assembly;
+use crate::decompose::scene_aware::metrics::TwoSided;
 use crate::export::format::round;
 use crate::inertia::VolumeSource;
 use serde::Serialize;
@@ -48,6 +49,12 @@ pub struct ObjectReport {
     pub extents: [f64; 3],
     pub hull_count: usize,
     pub hull_vertex_counts: Vec<usize>,
+    /// How close the collision hulls lie to the mesh, as fractions of its bounding-box
+    /// diagonal: `p95` = max(`hull_to_mesh_p95`, `mesh_to_hull_p95`) is the figure the
+    /// tolerance warning reads; `outside_p99`/`outside_max`: how far mesh surface lies
+    /// outside every hull. Absent for an export folder read back.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub collision_fit: Option<TwoSided>,
     pub fixed: bool,
     pub friction: f64,
     pub warnings: Vec<String>,
@@ -96,6 +103,13 @@ impl Report {
                     extents: [round(ext.x), round(ext.y), round(ext.z)],
                     hull_count: b.hulls.len(),
                     hull_vertex_counts: b.hulls.iter().map(|h| h.vertices.len()).collect(),
+                    collision_fit: b.fidelity.map(|f| TwoSided {
+                        p95: round(f.p95),
+                        hull_to_mesh_p95: round(f.hull_to_mesh_p95),
+                        mesh_to_hull_p95: round(f.mesh_to_hull_p95),
+                        outside_p99: round(f.outside_p99),
+                        outside_max: round(f.outside_max),
+                    }),
                     fixed: b.fixed,
                     friction: round(b.friction),
                     warnings: b.warnings.clone(),

@@ -94,6 +94,7 @@ pub fn load(path: &Path, limits: &Limits) -> Result<Assembly> {
             friction: o.friction.unwrap_or(crate::body::DEFAULT_FRICTION),
             fixed: o.fixed,
             warnings: Vec::new(),
+            fidelity: None,
         });
     }
     Ok(Assembly {

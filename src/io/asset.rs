@@ -496,6 +496,7 @@ impl Asset {
             friction,
             fixed: b.fixed,
             warnings: Vec::new(),
+            fidelity: None,
         }
     }
 }

@@ -5,6 +5,14 @@
 //!   the hulls — points on a hull's surface that lie inside another hull of the same set are
 //!   skipped, since they are not collision surface — and their unsigned distance to the mesh
 //!   surface, divided by the mesh's bounding-box diagonal.
+//! * **Mesh → hulls** ([`two_sided`]): points sampled uniformly on the *mesh* surface and their
+//!   distance to the boundary of the union of the hulls ([`union_boundary`]), relative to the
+//!   diagonal. This is what the first figure misses: a dent spanned by a flat hull face (the
+//!   face's nearest mesh point is on the rim) and a protrusion no hull reaches.
+//! * **Two-sided p95**: the larger of the two 95th percentiles, the headline figure the
+//!   report's tolerance warning reads.
+//! * **Outside depth**: for the same mesh samples, how far they lie outside every hull (0
+//!   inside one), 99th percentile and maximum, relative to the diagonal.
 //! * **Volume ratio**: volume of the union of the hulls (grid sampling, exact face-plane tests)
 //!   over the mesh's enclosed volume.
 //! * **Uncovered**: fraction of the mesh surface (sampled) farther than 0.1 % of the diagonal
@@ -16,6 +24,212 @@ use super::geom::{sample_hull, Surface};
 use crate::decompose::Hull;
 use crate::mesh::{Aabb, Mesh, P3, V3};
 use rayon::prelude::*;
+use serde::{Deserialize, Serialize};
+
+/// Collision fidelity measured both ways, every figure relative to the mesh's bounding-box
+/// diagonal (see the module doc).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct TwoSided {
+    /// The headline: `max(hull_to_mesh_p95, mesh_to_hull_p95)`.
+    pub p95: f64,
+    /// Boundary of the union of hulls → mesh surface, 95th percentile.
+    pub hull_to_mesh_p95: f64,
+    /// Mesh surface → boundary of the union of hulls, 95th percentile.
+    pub mesh_to_hull_p95: f64,
+    /// Depth of the mesh surface outside every hull, 99th percentile and maximum.
+    pub outside_p99: f64,
+    pub outside_max: f64,
+}
+
+/// Samples on each side for the figures written to `report.json`.
+pub const TWO_SIDED_SAMPLES: usize = 6000;
+
+/// Both directions with about `n` samples on each side; `None` without mesh or hull surface.
+pub fn two_sided(s: &Surface, hulls: &[Hull], n: usize) -> Option<TwoSided> {
+    let fwd = surface_distances(s, hulls, n);
+    let boundary = union_boundary(hulls, s.diag)?;
+    let pts = s.samples(n, 0x5eed);
+    if fwd.is_empty() || pts.is_empty() {
+        return None;
+    }
+    let eps = 1e-9 * s.diag;
+    let (back, out): (Vec<f64>, Vec<f64>) = pts
+        .par_iter()
+        .map(|p| {
+            let d = boundary.distance(p) / s.diag;
+            let inside = hulls.iter().any(|h| h.holds(p, eps));
+            (d, if inside { 0.0 } else { d })
+        })
+        .unzip();
+    let h2m = stats(&fwd).1;
+    let m2h = stats(&back).1;
+    Some(TwoSided {
+        p95: h2m.max(m2h),
+        hull_to_mesh_p95: h2m,
+        mesh_to_hull_p95: m2h,
+        outside_p99: percentile(&out, 0.99),
+        outside_max: out.iter().copied().fold(0.0, f64::max),
+    })
+}
+
+/// Distances (relative to the diagonal) from about `n` points on the mesh surface to the
+/// boundary of the union of the hulls; `None` without hull surface.
+pub fn mesh_to_hull_distances(s: &Surface, hulls: &[Hull], n: usize) -> Option<Vec<f64>> {
+    let boundary = union_boundary(hulls, s.diag)?;
+    Some(
+        s.samples(n, 0x5eed)
+            .par_iter()
+            .map(|p| boundary.distance(p) / s.diag)
+            .collect(),
+    )
+}
+
+/// A quick lower estimate of [`mesh_to_hull_distances`] for the engine's choices, without
+/// building the union boundary: a point inside hulls by its depth in the one it is deepest in
+/// (exact unless the nearest face of that hull is buried in another), a point outside all by
+/// its largest face-plane distance to the nearest (within √3 of the distance).
+pub fn mesh_to_hull_planes(s: &Surface, hulls: &[Hull], n: usize) -> Vec<f64> {
+    s.samples(n, 0x5eed)
+        .par_iter()
+        .map(|p| {
+            let (mut depth, mut out) = (0.0f64, f64::INFINITY);
+            let mut inside = false;
+            for h in hulls {
+                let b = &h.aabb;
+                let gap = (0..3)
+                    .map(|a| (b.min[a] - p[a]).max(p[a] - b.max[a]).max(0.0))
+                    .fold(0.0, f64::max);
+                if gap > 0.0 && gap >= out {
+                    continue;
+                }
+                let d = h.plane_distance(p);
+                if d <= 0.0 {
+                    inside = true;
+                    depth = depth.max(-d);
+                } else {
+                    out = out.min(d);
+                }
+            }
+            (if inside { depth } else { out }) / s.diag
+        })
+        .collect()
+}
+
+/// Two-sided figures of `hulls` against `mesh` with [`TWO_SIDED_SAMPLES`] a side.
+pub fn two_sided_of(mesh: &Mesh, hulls: &[Hull]) -> Option<TwoSided> {
+    two_sided(&Surface::new(mesh)?, hulls, TWO_SIDED_SAMPLES)
+}
+
+/// The warning for hulls farther from the mesh than `tolerance` (relative to the diagonal) by
+/// the headline two-sided figure, with both directions and the outside depth; `None` within
+/// it. `hulls` of at most `max_hulls`.
+pub fn tolerance_warning(
+    f: &TwoSided,
+    tolerance: f64,
+    hulls: usize,
+    max_hulls: usize,
+) -> Option<String> {
+    // `!(p95 <= tolerance)`: a NaN figure warns too.
+    (!(f.p95 <= tolerance)).then(|| {
+        format!(
+            "collision hulls: 95th percentile of their distance to the mesh {:.2} % of its \
+             bounding-box diagonal (hulls → mesh {:.2} %, mesh → hulls {:.2} %; mesh surface \
+             outside every hull by {:.2} % at the 99th percentile, {:.2} % at most), above the \
+             {:.2} % tolerance ({hulls} of at most {max_hulls} hulls; a larger --max-hulls \
+             usually brings them closer)",
+            f.p95 * 100.0,
+            f.hull_to_mesh_p95 * 100.0,
+            f.mesh_to_hull_p95 * 100.0,
+            f.outside_p99 * 100.0,
+            f.outside_max * 100.0,
+            tolerance * 100.0,
+        )
+    })
+}
+
+/// The `q`-quantile of `d` (nearest rank; 0 for an empty set).
+pub fn percentile(d: &[f64], q: f64) -> f64 {
+    if d.is_empty() {
+        return 0.0;
+    }
+    let mut v = d.to_vec();
+    v.sort_by(f64::total_cmp);
+    v[((v.len() as f64 * q) as usize).min(v.len() - 1)]
+}
+
+/// The boundary of the union of `hulls` as a triangle surface: the hulls' faces less the
+/// parts inside another hull. A face triangle with its three corners within 1e-6 of the
+/// diagonal of one other hull lies in it (convexity) and goes, seams between hulls that meet
+/// on a cut plane included; one that a neighbour's box reaches is quartered down to edges of
+/// [`BOUNDARY_EDGE`] of the diagonal while another hull may cut it (no face plane of that
+/// hull has all three corners beyond it), and the pieces not inside one hull are kept. Distances
+/// to it are exact where no hull crosses a face, and short by at most that edge next to where
+/// one does.
+pub fn union_boundary(hulls: &[Hull], diag: f64) -> Option<Surface> {
+    let eps = 1e-6 * diag;
+    let min_edge = BOUNDARY_EDGE * diag;
+    let tris: Vec<Vec<[P3; 3]>> = hulls
+        .par_iter()
+        .enumerate()
+        .map(|(i, h)| {
+            let others: Vec<&Hull> = hulls
+                .iter()
+                .enumerate()
+                .filter(|&(j, g)| j != i && g.aabb.intersects(&h.aabb, eps))
+                .map(|(_, g)| g)
+                .collect();
+            let mut out = Vec::new();
+            let mut stack: Vec<[P3; 3]> = h
+                .triangles
+                .iter()
+                .map(|t| t.map(|k| h.vertices[k as usize]))
+                .collect();
+            stack.reverse();
+            while let Some(t) = stack.pop() {
+                if others.iter().any(|g| t.iter().all(|p| g.holds(p, eps))) {
+                    continue; // inside `g`
+                }
+                let Some(b) = Aabb::of_points(&t) else {
+                    continue;
+                };
+                // `g` may cut the triangle unless one of its face planes has all three
+                // corners beyond it.
+                let crossed = others.iter().any(|g| {
+                    g.aabb.intersects(&b, eps)
+                        && !g
+                            .planes
+                            .iter()
+                            .any(|(n, d)| t.iter().all(|p| n.dot(&p.coords) - d > eps))
+                });
+                let longest = (0..3)
+                    .map(|k| (t[(k + 1) % 3] - t[k]).norm())
+                    .fold(0.0, f64::max);
+                if crossed && longest > min_edge {
+                    let m =
+                        [0, 1, 2].map(|k| P3::from((t[k].coords + t[(k + 1) % 3].coords) / 2.0));
+                    stack.push([m[0], m[1], m[2]]);
+                    stack.push([m[2], m[1], t[2]]);
+                    stack.push([m[1], m[0], t[1]]);
+                    stack.push([t[0], m[0], m[2]]);
+                } else {
+                    out.push(t);
+                }
+            }
+            out
+        })
+        .collect();
+    let mut mesh = Mesh::default();
+    for t in tris.into_iter().flatten() {
+        let k = mesh.vertices.len() as u32;
+        mesh.vertices.extend(t);
+        mesh.triangles.push([k, k + 1, k + 2]);
+    }
+    Surface::new(&mesh)
+}
+
+/// Edge length (relative to the diagonal) down to which [`union_boundary`] splits the faces
+/// another hull crosses.
+pub const BOUNDARY_EDGE: f64 = 2e-3;
 
 /// Measured quality of a set of hulls for one mesh.
 #[derive(Clone, Debug, Default, PartialEq)]
@@ -28,6 +242,8 @@ pub struct Quality {
     pub dist_p95: f64,
     pub dist_max: f64,
     pub uncovered: f64,
+    /// Both directions (see [`two_sided`]).
+    pub two_sided: TwoSided,
     /// `None` when the mesh is not a container.
     pub cavity_kept: Option<bool>,
 }
@@ -56,6 +272,7 @@ pub fn measure(mesh: &Mesh, hulls: &[Hull]) -> Quality {
         dist_p95: p95,
         dist_max: max,
         uncovered: uncovered(&s, hulls, 8_000),
+        two_sided: two_sided(&s, hulls, 20_000).unwrap_or_default(),
         cavity_kept: cavity_probe(&s).map(|p| !hulls.iter().any(|h| h.contains(&p))),
     }
 }
@@ -182,3 +399,6 @@ pub fn cavity_probe(s: &Surface) -> Option<P3> {
     }
     Some(p)
 }
+
+#[cfg(test)]
+mod tests;

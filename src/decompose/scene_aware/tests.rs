@@ -225,15 +225,16 @@ fn check_scene(path: &Path) -> SceneAwareReport {
     let worst = deepest_cross_overlap(&hulls);
     assert!(worst <= 1e-4, "{}: overlap {worst}", path.display());
     assert!(worst == 0.0, "{}: overlap {worst}", path.display());
-    for r in &rep.objects {
+    for (k, r) in rep.objects.iter().enumerate() {
         assert_eq!(r.overlaps, 0);
         assert!(r.mesh_penetration.is_empty(), "{r:?}");
-        // An object farther from its mesh than the tolerance says so.
-        let above = r
-            .warnings()
-            .iter()
-            .any(|w| w.contains("above the 1.00 % tolerance"));
-        assert_eq!(above, r.distance_p95 > o.tolerance, "{r:?}");
+        // An object farther from its mesh than the tolerance, either way, says so (the
+        // warning `body::assemble` adds), and the headline is never below the engine's own
+        // one-sided figure by more than the sampling spread.
+        let f = metrics::two_sided_of(&meshes[k], &hulls[k]).unwrap();
+        let w = metrics::tolerance_warning(&f, o.tolerance, hulls[k].len(), o.max_hulls);
+        assert_eq!(w.is_some(), f.p95 > o.tolerance, "{f:?}");
+        assert!(f.p95 >= 0.8 * r.distance_p95, "{f:?} {r:?}");
     }
     // The support (object 0) keeps its cavity where it is a container.
     let s = geom::Surface::new(&meshes[0]).unwrap();
@@ -458,29 +459,6 @@ fn interpenetrating_meshes_are_reported_and_hulls_cut_apart() {
     assert!((pen.1 - 0.001).abs() < 1e-6, "{pen:?}");
     assert_eq!(deepest_cross_overlap(&hulls), 0.0);
     assert!(!rep.objects[0].warnings().is_empty());
-}
-
-/// The report warns when the hulls lie farther from the mesh than the tolerance (95th
-/// percentile), with the figures, and only then.
-#[test]
-fn hulls_above_the_tolerance_are_a_warning() {
-    let mut r = ObjectReport {
-        hulls: 32,
-        distance_p95: 0.0131,
-        tolerance: 0.01,
-        max_hulls: 32,
-        ..Default::default()
-    };
-    assert_eq!(
-        r.warnings(),
-        [
-            "collision hulls: 95th percentile of their distance to the mesh 1.31 % of its \
-          bounding-box diagonal, above the 1.00 % tolerance (32 of at most 32 hulls; a larger \
-          --max-hulls usually brings them closer)"
-        ]
-    );
-    r.distance_p95 = 0.0099;
-    assert!(r.warnings().is_empty());
 }
 
 #[test]
