@@ -302,7 +302,7 @@ pub fn run_scene(g: &Generated, out: &Path) -> Result<Ours> {
                 diagonal: diagonal(b),
                 rest_displacement: r.map(|r| r.rest_displacement).unwrap_or(0.0),
                 rest_rotation_deg: r.map(|r| r.rest_rotation_deg).unwrap_or(0.0),
-                marginal: false,
+                marginal: r.map(|r| r.marginal).unwrap_or(false),
             }
         })
         .collect();

@@ -31,6 +31,7 @@ use rapier3d_f64::prelude::{
 use serde::Serialize;
 
 mod fresh;
+pub mod probe;
 mod settle;
 mod world;
 
@@ -146,6 +147,13 @@ pub struct SettleOptions {
     /// supported body has at least this upward (z) component (0.1 ≈ 6° above horizontal): side
     /// contacts between neighbours are not supports, a mug's rim under a leaning pen is.
     pub support_min_normal_z: f64,
+    /// The marginal probe ([`probe`]): after the rest phase each dynamic body is rolled by this
+    /// angle (degrees) about a horizontal axis through its lowest point, in four directions; it
+    /// is marginal when it ends turned more than half of it from its rest pose. 0 disables it.
+    pub probe_angle_deg: f64,
+    /// How long (s) each of the four probes runs before the body's turn from its rest pose is
+    /// measured.
+    pub probe_time: f64,
 }
 
 impl Default for SettleOptions {
@@ -177,6 +185,8 @@ impl Default for SettleOptions {
             support_distance: 0.002,
             support_release_margin: 0.001,
             support_min_normal_z: 0.1,
+            probe_angle_deg: 0.5,
+            probe_time: 0.3,
         }
     }
 }
@@ -253,6 +263,13 @@ pub struct BodyReport {
     pub reasons: Vec<String>,
     /// Observations that do not fail the body.
     pub notes: Vec<String>,
+    /// The rest pose is only balanced: rolled 0.5° off it, the body did not come back (see
+    /// [`probe`]). Other engines may not hold it; it does not fail the body.
+    pub marginal: bool,
+    /// Largest drift from the rest pose at the end of the four probes (m, degrees); 0 with the
+    /// probe off.
+    pub probe_displacement: f64,
+    pub probe_rotation_deg: f64,
 }
 
 /// The outcome of [`settle`].
@@ -269,6 +286,8 @@ pub struct SettleReport {
     pub dt: f64,
     /// Scene-level observations that do not fail the scene.
     pub warnings: Vec<String>,
+    /// Names of the bodies whose rest pose is marginal (see [`BodyReport::marginal`]).
+    pub marginal: Vec<String>,
 }
 
 /// Poses of every body over time, from [`simulate`].

@@ -72,6 +72,7 @@ pub fn settle(bodies: &[SimBody], opts: &SettleOptions) -> Result<SettleReport, 
         }
     }
     let finals: Vec<Isometry3<f64>> = (0..n).map(|i| sim.pose(i)).collect();
+    let probed = super::probe::probe(bodies, &finals, opts)?;
 
     // Verdicts.
     let name_of = |k: Option<usize>| k.map(|k| sim.name(k).to_string());
@@ -183,6 +184,17 @@ pub fn settle(bodies: &[SimBody], opts: &SettleOptions) -> Result<SettleReport, 
                 mm(opts.max_rest_penetration)
             ));
         }
+        let (probe_displacement, probe_rotation_deg) = probed[i];
+        let marginal = !b.fixed && probe_rotation_deg > 0.5 * opts.probe_angle_deg;
+        if marginal {
+            notes.push(format!(
+                "marginal rest: rolled {}° off its rest pose, it did not come back (still {:.2} mm / {:.2}° off after {} s; other engines may not hold this pose)",
+                opts.probe_angle_deg,
+                mm(probe_displacement),
+                probe_rotation_deg,
+                opts.probe_time
+            ));
+        }
         reports.push(BodyReport {
             name: b.name.clone(),
             fixed: b.fixed,
@@ -206,10 +218,25 @@ pub fn settle(bodies: &[SimBody], opts: &SettleOptions) -> Result<SettleReport, 
             passed: reasons.is_empty(),
             reasons,
             notes,
+            marginal,
+            probe_displacement,
+            probe_rotation_deg,
         });
+    }
+    let marginal: Vec<String> = reports
+        .iter()
+        .filter(|r| r.marginal)
+        .map(|r| r.name.clone())
+        .collect();
+    if !marginal.is_empty() {
+        warnings.push(format!(
+            "marginal rest pose (balanced, not stable; other engines may roll it away): {}",
+            marginal.join(", ")
+        ));
     }
     Ok(SettleReport {
         passed: reports.iter().all(|r| r.passed),
+        marginal,
         bodies: reports,
         time_to_sleep,
         settle_steps,

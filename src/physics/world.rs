@@ -450,6 +450,12 @@ pub(super) fn validate_options(o: &SettleOptions) -> Result<(), PhysicsError> {
     if !o.support_min_normal_z.is_finite() || o.support_min_normal_z.abs() > 1.0 {
         return bad("support_min_normal_z must be in [-1, 1]");
     }
+    if !(o.probe_angle_deg.is_finite() && o.probe_angle_deg >= 0.0 && o.probe_angle_deg <= 10.0) {
+        return bad("probe_angle_deg must be in [0, 10]");
+    }
+    if !(o.probe_time.is_finite() && o.probe_time >= 0.0) {
+        return bad("probe_time must be finite and >= 0");
+    }
     Ok(())
 }
 
