@@ -76,7 +76,10 @@ fn main() {
         for j in &judged {
             writeln!(lines, "{}", serde_json::to_string(j).unwrap()).unwrap();
             if let Some(c) = interact3d::agreement::judge::cause(j) {
-                eprintln!("seed {} {:?}: {c}; drifts {:?}", j.seed, j.objects, j.rest_drifts);
+                eprintln!(
+                    "seed {} {:?}: {c}; drifts {:?}",
+                    j.seed, j.objects, j.rest_drifts
+                );
             }
         }
         if !keep {

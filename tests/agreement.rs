@@ -35,7 +35,10 @@ fn generated_scenes_agree_with_mujoco() {
     let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/python/agreement_mujoco.py");
     let judged = judge(&python, &script, &scenes).unwrap();
     let passed = judged.iter().filter(|j| j.ours.passed).count();
-    assert!(passed >= 3, "too few passing scenes to judge rest: {passed}");
+    assert!(
+        passed >= 3,
+        "too few passing scenes to judge rest: {passed}"
+    );
     for j in &judged {
         eprintln!(
             "seed {} {:?} {:?}: ours {} MuJoCo {} drifts {:?}",
@@ -43,6 +46,12 @@ fn generated_scenes_agree_with_mujoco() {
         );
         assert!(j.mujoco.finite);
         assert!(j.verdict_agrees, "seed {}: verdicts differ: {j:?}", j.seed);
-        assert_ne!(j.rest_agrees, Some(false), "seed {}: {:?}", j.seed, j.rest_drifts);
+        assert_ne!(
+            j.rest_agrees,
+            Some(false),
+            "seed {}: {:?}",
+            j.seed,
+            j.rest_drifts
+        );
     }
 }

@@ -105,7 +105,11 @@ pub fn judge(
     if results.len() != scenes.len() {
         return Err(Error::input(
             script,
-            format!("judge answered {} of {} scenes", results.len(), scenes.len()),
+            format!(
+                "judge answered {} of {} scenes",
+                results.len(),
+                scenes.len()
+            ),
         ));
     }
     Ok(scenes
@@ -184,7 +188,15 @@ pub fn cause(j: &Judged) -> Option<String> {
                 .ours
                 .reasons
                 .first()
-                .map(|r| r.split(':').nth(1).unwrap_or(r).trim().chars().take(40).collect())
+                .map(|r| {
+                    r.split(':')
+                        .nth(1)
+                        .unwrap_or(r)
+                        .trim()
+                        .chars()
+                        .take(40)
+                        .collect()
+                })
                 .unwrap_or_default();
             format!("verdict: we fail, MuJoCo passes ({:?}; {first})", j.kind)
         });

@@ -166,7 +166,10 @@ impl Catalog {
         let mut tilt_deg = 0.0;
         for (level, &k) in stack.iter().enumerate() {
             let o = &self.objects[k];
-            let yaw = UnitQuaternion::from_axis_angle(&Vector3::z_axis(), rng.range(0.0, 360.0).to_radians());
+            let yaw = UnitQuaternion::from_axis_angle(
+                &Vector3::z_axis(),
+                rng.range(0.0, 360.0).to_radians(),
+            );
             let top = level + 1 == stack.len();
             let tilt = if top && level > 0 || stack.len() == 1 {
                 let t = rng.range(0.0, MAX_TILT_DEG);
@@ -181,7 +184,11 @@ impl Catalog {
             // Over the body below: its centre, shifted by up to a quarter of its extents.
             let (x, y) = match placed.last() {
                 Some((below, pose)) => {
-                    let e = self.objects[*below].body.geometry.aabb().map(|b| b.extents());
+                    let e = self.objects[*below]
+                        .body
+                        .geometry
+                        .aabb()
+                        .map(|b| b.extents());
                     let e = e.unwrap_or_default();
                     (
                         pose.translation.x + rng.range(-0.25, 0.25) * e.x,
@@ -194,7 +201,10 @@ impl Catalog {
             let pose = Isometry3::from_parts(Translation3::new(x, y, z), rot);
             placed.push((k, pose));
             let mut b = o.body.clone();
-            b.name = format!("b{level}_{}", crate::scene::sanitize_name(o.id.rsplit('/').next().unwrap_or(&o.id)));
+            b.name = format!(
+                "b{level}_{}",
+                crate::scene::sanitize_name(o.id.rsplit('/').next().unwrap_or(&o.id))
+            );
             b.pose = pose;
             b.composed_pose = pose;
             bodies.push(b);
@@ -272,8 +282,7 @@ pub fn run_scene(g: &Generated, out: &Path) -> Result<Ours> {
     if v.passed {
         crate::validate::apply_settled_poses(&mut a, &v);
     }
-    report.validation =
-        Some(serde_json::to_value(&v).map_err(|e| Error::Internal(e.to_string()))?);
+    report.validation = Some(serde_json::to_value(&v).map_err(|e| Error::Internal(e.to_string()))?);
     crate::export::export(
         &a,
         &report,

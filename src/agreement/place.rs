@@ -93,11 +93,7 @@ impl Placer {
                     .map(move |(s, pts)| (s, to_pose(pose), bounds(pts, pose)))
             })
             .collect();
-        let Some(top) = others
-            .iter()
-            .map(|o| o.2 .1[2])
-            .reduce(f64::max)
-        else {
+        let Some(top) = others.iter().map(|o| o.2 .1[2]).reduce(f64::max) else {
             return floor;
         };
         let hits = |z: f64| -> bool {
@@ -106,7 +102,8 @@ impl Placer {
             self.shapes[k].iter().any(|(s, pts)| {
                 let b = bounds(pts, &iso);
                 others.iter().any(|(o, op, ob)| {
-                    overlap(&b, ob) && query::intersection_test(&pose, s, op, *o).is_ok_and(|i| i.intersecting)
+                    overlap(&b, ob)
+                        && query::intersection_test(&pose, s, op, *o).is_ok_and(|i| i.intersecting)
                 })
             })
         };
@@ -114,7 +111,11 @@ impl Placer {
         loop {
             let z = free - STEP;
             if z <= floor {
-                return if hits(floor) { bisect(free, floor, &hits) } else { floor };
+                return if hits(floor) {
+                    bisect(free, floor, &hits)
+                } else {
+                    floor
+                };
             }
             if hits(z) {
                 return bisect(free, z, &hits);

@@ -318,7 +318,6 @@ fn body_error(body: &SimBody, message: impl Into<String>) -> PhysicsError {
     }
 }
 
-
 /// How far below z = 0 the floor's top face lies (m). Prepared scenes rest on z = 0, and a
 /// hull's lowest vertex ends up there only to f64 rounding: 1.4e-17 m *above* it, say. At such
 /// a separation, below GJK's tolerance, parry's contact query gave a hull touching the floor
@@ -327,7 +326,6 @@ fn body_error(body: &SimBody, message: impl Into<String>) -> PhysicsError {
 /// its fruits out. Exactly at 0, below it, or 1e-12 m above it, the normals are right. 10 nm is
 /// far above the rounding and far below anything the checks measure.
 pub const FLOOR_GAP: f64 = 1e-8;
-
 
 #[cfg(test)]
 mod tests;

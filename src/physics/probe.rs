@@ -12,9 +12,9 @@
 //!
 //! Entry point: [`probe`].
 
+use super::settle::{drift, steps_for};
 use super::world::Sim;
 use super::*;
-use super::settle::{drift, steps_for};
 
 /// Worst (displacement m, rotation degrees) of each body from `rest` at the end of a probe
 /// (zeros for fixed bodies, and for every body when the probe is off).
@@ -37,12 +37,7 @@ pub(super) fn probe(
         })
         .collect();
     let angle = opts.probe_angle_deg.to_radians();
-    for axis in [
-        Vector3::x(),
-        Vector3::y(),
-        -Vector3::x(),
-        -Vector3::y(),
-    ] {
+    for axis in [Vector3::x(), Vector3::y(), -Vector3::x(), -Vector3::y()] {
         let nudged: Vec<SimBody> = at_rest
             .iter()
             .map(|b| {
@@ -58,14 +53,12 @@ pub(super) fn probe(
                         .unwrap_or(pose * b.com)
                 };
                 let p = lowest(&b.pose);
-                let turn = UnitQuaternion::from_axis_angle(&nalgebra::Unit::new_unchecked(axis), angle);
+                let turn =
+                    UnitQuaternion::from_axis_angle(&nalgebra::Unit::new_unchecked(axis), angle);
                 let about = Translation3::from(p.coords);
                 let mut pose = about * turn * about.inverse() * b.pose;
                 pose.translation.vector.z += p.z - lowest(&pose).z;
-                SimBody {
-                    pose,
-                    ..b.clone()
-                }
+                SimBody { pose, ..b.clone() }
             })
             .collect();
         let mut sim = Sim::new(&nudged, opts)?;

@@ -1,8 +1,8 @@
 //! The settle test itself: [`settle`] (settle phase, rest phase, verdicts) and [`simulate`]
 //! (a plain run that records poses).
 
-use super::*;
 use super::world::Sim;
+use super::*;
 
 /// Run the settle test (settle phase, then rest phase) on a scene.
 pub fn settle(bodies: &[SimBody], opts: &SettleOptions) -> Result<SettleReport, PhysicsError> {
@@ -307,4 +307,3 @@ pub(super) fn names(sim: &Sim, ks: &[usize]) -> String {
         .collect::<Vec<_>>()
         .join(", ")
 }
-

@@ -21,7 +21,6 @@ pub fn rapier_mass_properties(body: &SimBody) -> Result<(f64, P3, Matrix3<f64>),
     ))
 }
 
-
 pub(super) fn to_pose(iso: &Isometry3<f64>) -> Pose {
     let q = iso.rotation.quaternion();
     let t = iso.translation.vector;
@@ -109,7 +108,10 @@ pub(super) struct Sim<'a> {
 }
 
 impl<'a> Sim<'a> {
-    pub(super) fn new(bodies: &'a [SimBody], opts: &'a SettleOptions) -> Result<Self, PhysicsError> {
+    pub(super) fn new(
+        bodies: &'a [SimBody],
+        opts: &'a SettleOptions,
+    ) -> Result<Self, PhysicsError> {
         validate_options(opts)?;
         let mut world = PhysicsWorld::new();
         world.narrow_phase = NarrowPhase::with_query_dispatcher(fresh::Fresh);
@@ -517,4 +519,3 @@ pub(super) fn body_builder(
     act.time_until_sleep = opts.sleep_time;
     Ok((rb, diag))
 }
-
