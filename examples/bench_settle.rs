@@ -145,6 +145,18 @@ fn main() {
         t * 1e3,
         rep.steps as f64 / t
     );
+    let no_probe = SettleOptions {
+        probe_angle_deg: 0.0,
+        ..opts.clone()
+    };
+    let (t, rep0) = best_of(5, || settle(&scene, &no_probe).unwrap());
+    println!(
+        "{:<36} {:>7} {:>10.2} {:>12.0}",
+        "the same, marginal probe off",
+        rep0.steps,
+        t * 1e3,
+        rep0.steps as f64 / t
+    );
     println!(
         "{hulls} hulls; verdict: {}",
         if rep.passed { "pass" } else { "fail" }

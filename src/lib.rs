@@ -12,6 +12,7 @@
 // Coordinate loops (`for k in 0..3`) index several arrays in step; that reads better than zips.
 #![allow(clippy::needless_range_loop)]
 
+pub mod agreement;
 pub mod batch;
 pub mod body;
 pub mod compose;

@@ -490,3 +490,63 @@ fn scanned_objects_rest_on_the_floor_and_on_a_box_without_sinking() {
         );
     }
 }
+
+/// A 8 x 6 x 4 cm box on its face whose centre of mass sits `d` inside its +x bottom edge, 2 cm
+/// up: its stability margin towards +x is atan(d / 2 cm).
+fn lopsided_box(d: f64) -> SimBody {
+    let e = V3::new(0.08, 0.06, 0.04);
+    SimBody {
+        com: P3::new(0.04 - d, 0.0, 0.0),
+        ..box_body("box", e, 0.2, at(0.0, 0.0, 0.02))
+    }
+}
+
+/// Settle with the start kick off: the lopsided boxes rest exactly as placed.
+fn run_unkicked(bodies: &[SimBody]) -> SettleReport {
+    let opts = SettleOptions {
+        perturbation_speed: 0.0,
+        ..SettleOptions::default()
+    };
+    settle(bodies, &opts).unwrap()
+}
+
+#[test]
+fn probe_calls_a_box_on_its_face_stable() {
+    let e = V3::new(0.08, 0.06, 0.04);
+    let r = run(&[box_body("box", e, 0.2, at(0.0, 0.0, 0.02 + 0.0005))]);
+    let b = body(&r, "box");
+    assert!(r.passed, "{:?}", b.reasons);
+    // Rolled 0.5° about an edge of its bottom face, a box falls back flat.
+    assert!(!b.marginal, "{b:?}");
+    assert!(b.probe_rotation_deg < 0.1, "{}", b.probe_rotation_deg);
+    assert!(r.marginal.is_empty());
+}
+
+#[test]
+fn probe_calls_a_pose_marginal_when_its_margin_is_under_the_nudge() {
+    // d = 0.15 mm: margin atan(0.15 / 20) = 0.43° < the 0.5° nudge. It rests (nothing pushes
+    // it), but rolled 0.5° onto its +x edge its centre of mass is past the edge: it topples.
+    let r = run_unkicked(&[lopsided_box(1.5e-4)]);
+    let b = body(&r, "box");
+    assert!(r.passed, "{:?}", b.reasons);
+    assert!(b.marginal, "{b:?}");
+    assert!(b.probe_rotation_deg > 0.25, "{}", b.probe_rotation_deg);
+    assert_eq!(r.marginal, vec!["box".to_string()]);
+    // d = 2 mm: margin 5.7°, far above the nudge: it falls back onto its face.
+    let r = run_unkicked(&[lopsided_box(2e-3)]);
+    let b = body(&r, "box");
+    assert!(r.passed, "{:?}", b.reasons);
+    assert!(!b.marginal, "{b:?}");
+    assert!(b.probe_rotation_deg < 0.25, "{}", b.probe_rotation_deg);
+}
+
+#[test]
+fn probe_off_reports_nothing() {
+    let opts = SettleOptions {
+        probe_angle_deg: 0.0,
+        ..SettleOptions::default()
+    };
+    let r = settle(&[lopsided_box(1.5e-4)], &opts).unwrap();
+    assert!(!r.bodies[0].marginal);
+    assert_eq!(r.bodies[0].probe_rotation_deg, 0.0);
+}

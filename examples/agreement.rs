@@ -1,0 +1,129 @@
+//! Cross-engine rest agreement over generated scenes (issue #33): random item-in/on-support,
+//! item-on-item and item-on-floor scenes from `../shared/datasets/objects`, settled in Rapier and
+//! exported by the library, then replayed in MuJoCo (`tests/python/agreement_mujoco.py`).
+//! Prints one line per disagreeing scene and a summary table; writes OUT/scenes.jsonl (every
+//! scene, both engines) and OUT/summary.json.
+//!
+//! Run: `nice cargo run --release --example agreement -- [--seeds 0..300] [--out DIR]
+//!       [--objects DIR] [--batch 10] [--keep]` (the judge's interpreter: `INTERACT3D_PYTHON`,
+//! default `python3`). Objects are decomposed once each and cached in `target/agreement-cache`.
+
+use interact3d::agreement::{judge, run_scene, summary, Catalog, Judged};
+use rayon::prelude::*;
+use std::io::Write;
+use std::path::PathBuf;
+
+fn main() {
+    let mut seeds = 0u64..300;
+    let mut out = PathBuf::from("target/agreement");
+    let mut objects = PathBuf::from("../shared/datasets/objects");
+    let mut batch = 10usize;
+    let mut keep = false;
+    let mut args = std::env::args().skip(1);
+    while let Some(a) = args.next() {
+        match a.as_str() {
+            "--seeds" => {
+                let v = args.next().expect("--seeds A..B");
+                let (a, b) = v.split_once("..").expect("--seeds A..B");
+                seeds = a.parse().expect("seed")..b.parse().expect("seed");
+            }
+            "--out" => out = args.next().expect("--out DIR").into(),
+            "--objects" => objects = args.next().expect("--objects DIR").into(),
+            "--batch" => batch = args.next().expect("--batch N").parse().expect("N"),
+            "--keep" => keep = true,
+            _ => {
+                eprintln!("unknown argument {a}");
+                std::process::exit(2);
+            }
+        }
+    }
+    let python = std::env::var("INTERACT3D_PYTHON").unwrap_or_else(|_| "python3".into());
+    let script = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/python/agreement_mujoco.py");
+    std::fs::create_dir_all(&out).expect("output folder");
+    let t = std::time::Instant::now();
+    let catalog = Catalog::load(&objects, None, Some("target/agreement-cache".into()))
+        .unwrap_or_else(|e| {
+            eprintln!("{e}");
+            std::process::exit(2)
+        });
+    eprintln!(
+        "{} objects decomposed in {:.1} s",
+        catalog.objects.len(),
+        t.elapsed().as_secs_f64()
+    );
+    let mut lines = std::fs::File::create(out.join("scenes.jsonl")).expect("scenes.jsonl");
+    let mut all: Vec<Judged> = Vec::new();
+    let seed_list: Vec<u64> = seeds.clone().collect();
+    for chunk in seed_list.chunks(batch) {
+        let done: Vec<_> = chunk
+            .par_iter()
+            .filter_map(|&seed| {
+                let g = catalog.compose(seed);
+                let dir = out.join(format!("scene_{seed}"));
+                match run_scene(&g, &dir) {
+                    Ok(ours) => Some((g, ours, dir)),
+                    Err(e) => {
+                        eprintln!("seed {seed}: {e}");
+                        None
+                    }
+                }
+            })
+            .collect();
+        let judged = judge(&python, &script, &done).unwrap_or_else(|e| {
+            eprintln!("{e}");
+            std::process::exit(1)
+        });
+        for j in &judged {
+            writeln!(lines, "{}", serde_json::to_string(j).unwrap()).unwrap();
+            if let Some(c) = interact3d::agreement::judge::cause(j) {
+                eprintln!(
+                    "seed {} {:?}: {c}; drifts {:?}",
+                    j.seed, j.objects, j.rest_drifts
+                );
+            }
+        }
+        if !keep {
+            for (_, _, d) in &done {
+                let _ = std::fs::remove_dir_all(d);
+            }
+        }
+        all.extend(judged);
+        eprintln!("{} scenes, {:.0} s", all.len(), t.elapsed().as_secs_f64());
+    }
+    let s = summary(&all);
+    std::fs::write(
+        out.join("summary.json"),
+        serde_json::to_string_pretty(&s).unwrap(),
+    )
+    .unwrap();
+    let pct = |a: usize, n: usize| 100.0 * a as f64 / n.max(1) as f64;
+    println!("seeds {}..{} ({} scenes)", seeds.start, seeds.end, s.scenes);
+    println!("{:<44} {:>8}", "", "count");
+    println!("{:<44} {:>8}", "we pass", s.we_pass);
+    println!("{:<44} {:>8}", "MuJoCo passes", s.mujoco_pass);
+    println!(
+        "{:<44} {:>8}  ({:.1} %)",
+        "verdict agrees",
+        s.verdict_agree,
+        pct(s.verdict_agree, s.scenes)
+    );
+    println!(
+        "{:<44} {:>8}  ({:.1} % of {} we pass)",
+        "rest agrees (<= 1 mm, <= 1 deg for 2 s)",
+        s.rest_agree,
+        pct(s.rest_agree, s.rest_judged),
+        s.rest_judged
+    );
+    println!("{:<44} {:>8}", "scenes with a marginal body", s.marginal);
+    for (c, n) in &s.causes {
+        println!("  {c:<70} {n:>4}");
+    }
+    println!(
+        "MuJoCo drift of bodies at rest: mean {:.3} mm / {:.3} deg, worst {:.3} mm / {:.3} deg",
+        s.drift_mean_mm, s.drift_mean_deg, s.drift_worst_mm, s.drift_worst_deg
+    );
+    println!(
+        "settle (validation) per scene: mean {:.2} s, worst {:.2} s",
+        s.settle_mean_s, s.settle_worst_s
+    );
+}

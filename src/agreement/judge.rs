@@ -1,0 +1,247 @@
+//! The other engine's side: `tests/python/agreement_mujoco.py` replays every exported scene in
+//! MuJoCo (one process for a batch) and this module compares its answers with ours.
+//!
+//! MuJoCo's scene verdict ([`RULES`]) is the settle test's rule replayed from the `composed`
+//! keyframe: after 2 s every free body's centre of mass has moved at most 10 % of its
+//! bounding-box diagonal, and over the next 1 s it moves at most 1 mm and turns at most 1°.
+//! MuJoCo's rest answer: from the `settled` keyframe (the exported pose), every body stays
+//! within 1 mm and 1° for 2 s.
+
+use super::{Generated, Ours};
+use crate::error::{Error, Result};
+use serde::{Deserialize, Serialize};
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+
+/// MuJoCo's verdict rule, as written into the results.
+pub const RULES: &str = "from the composed pose: COM drift <= 10% of the bbox diagonal after 2 s, then <= 1 mm and <= 1 deg over 1 s; rest: <= 1 mm and <= 1 deg for 2 s from the settled pose";
+/// Rest agreement thresholds.
+pub const REST_MM: f64 = 1.0;
+pub const REST_DEG: f64 = 1.0;
+
+/// What MuJoCo reported on one body.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct MjBody {
+    /// Composed-pose run: COM drift after the settle part (m), then the rest part's worst
+    /// displacement (m) and turn (degrees).
+    pub settle_m: f64,
+    pub rest_m: f64,
+    pub rest_deg: f64,
+    /// Settled-pose run: worst displacement (m) and turn (degrees) over 2 s.
+    pub from_settled_m: f64,
+    pub from_settled_deg: f64,
+}
+
+/// What MuJoCo reported on one scene.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct MjScene {
+    pub dir: PathBuf,
+    pub passed: bool,
+    pub finite: bool,
+    pub bodies: BTreeMap<String, MjBody>,
+    pub seconds: f64,
+}
+
+/// One scene, both engines.
+#[derive(Clone, Debug, Serialize)]
+pub struct Judged {
+    pub seed: u64,
+    pub kind: super::Kind,
+    pub objects: Vec<String>,
+    pub tilt_deg: f64,
+    pub ours: Ours,
+    pub mujoco: MjScene,
+    pub verdict_agrees: bool,
+    /// `None` when we fail the scene (no rest pose claimed).
+    pub rest_agrees: Option<bool>,
+    /// Bodies we call at rest that MuJoCo moves past 1 mm / 1° (name, mm, degrees).
+    pub rest_drifts: Vec<(String, f64, f64)>,
+    /// Our own honesty flag: the scene had a body our probe calls marginal.
+    pub marginal: bool,
+}
+
+/// Run the MuJoCo judge on exported scenes (`dirs[i]` holds the export of `scenes[i]`).
+pub fn judge(
+    python: &str,
+    script: &Path,
+    scenes: &[(Generated, Ours, PathBuf)],
+) -> Result<Vec<Judged>> {
+    let list: Vec<serde_json::Value> = scenes
+        .iter()
+        .map(|(_, o, d)| {
+            serde_json::json!({
+                "dir": d,
+                "diagonals": o.bodies.iter().map(|b| (b.name.clone(), b.diagonal)).collect::<BTreeMap<_, _>>(),
+                "settled": o.passed,
+            })
+        })
+        .collect();
+    let input = std::env::temp_dir().join(format!(
+        "interact3d-agreement-{}-{}.json",
+        std::process::id(),
+        scenes.first().map(|s| s.0.seed).unwrap_or(0)
+    ));
+    std::fs::write(&input, serde_json::to_vec(&list).unwrap_or_default())
+        .map_err(|e| Error::input(&input, e.to_string()))?;
+    let out = std::process::Command::new(python)
+        .arg(script)
+        .arg(&input)
+        .output()
+        .map_err(|e| Error::input(script, format!("cannot run {python}: {e}")))?;
+    let _ = std::fs::remove_file(&input);
+    if !out.status.success() {
+        return Err(Error::input(
+            script,
+            format!("judge failed: {}", String::from_utf8_lossy(&out.stderr)),
+        ));
+    }
+    let text = String::from_utf8_lossy(&out.stdout);
+    let results: Vec<MjScene> = text
+        .lines()
+        .filter(|l| l.starts_with('{'))
+        .map(serde_json::from_str)
+        .collect::<std::result::Result<_, _>>()
+        .map_err(|e| Error::input(script, format!("judge output: {e}")))?;
+    if results.len() != scenes.len() {
+        return Err(Error::input(
+            script,
+            format!(
+                "judge answered {} of {} scenes",
+                results.len(),
+                scenes.len()
+            ),
+        ));
+    }
+    Ok(scenes
+        .iter()
+        .zip(results)
+        .map(|((g, ours, _), mj)| compare(g, ours, mj))
+        .collect())
+}
+
+fn compare(g: &Generated, ours: &Ours, mj: MjScene) -> Judged {
+    let mut rest_drifts = Vec::new();
+    if ours.passed {
+        // A marginal body is not claimed to be at rest (it is reported as marginal instead).
+        for b in ours.bodies.iter().filter(|b| !b.marginal) {
+            if let Some(m) = mj.bodies.get(&b.name) {
+                let (mm, deg) = (m.from_settled_m * 1e3, m.from_settled_deg);
+                if !(mm <= REST_MM && deg <= REST_DEG) {
+                    rest_drifts.push((b.name.clone(), mm, deg));
+                }
+            }
+        }
+    }
+    Judged {
+        seed: g.seed,
+        kind: g.kind,
+        objects: g.objects.clone(),
+        tilt_deg: g.tilt_deg,
+        verdict_agrees: ours.passed == mj.passed,
+        rest_agrees: ours.passed.then_some(rest_drifts.is_empty()),
+        rest_drifts,
+        marginal: ours.bodies.iter().any(|b| b.marginal),
+        ours: ours.clone(),
+        mujoco: mj,
+    }
+}
+
+/// Totals over a run.
+#[derive(Clone, Debug, Default, Serialize)]
+pub struct Summary {
+    pub scenes: usize,
+    pub we_pass: usize,
+    pub mujoco_pass: usize,
+    pub verdict_agree: usize,
+    pub rest_judged: usize,
+    pub rest_agree: usize,
+    pub marginal: usize,
+    /// Disagreements by cause (a short key: direction and what moved).
+    pub causes: BTreeMap<String, usize>,
+    /// Mean and worst settle (validation) time per scene (s).
+    pub settle_mean_s: f64,
+    pub settle_worst_s: f64,
+    /// Mean and worst cross-engine drift (mm, degrees) of bodies we call at rest.
+    pub drift_mean_mm: f64,
+    pub drift_worst_mm: f64,
+    pub drift_mean_deg: f64,
+    pub drift_worst_deg: f64,
+}
+
+/// A short name of why a scene disagrees (empty when it agrees).
+pub fn cause(j: &Judged) -> Option<String> {
+    if !j.verdict_agrees {
+        return Some(if j.ours.passed {
+            let worst = j
+                .mujoco
+                .bodies
+                .iter()
+                .map(|(n, b)| (n, b.rest_m.max(b.settle_m)))
+                .max_by(|a, b| a.1.total_cmp(&b.1));
+            format!(
+                "verdict: we pass, MuJoCo fails ({:?}; {})",
+                j.kind,
+                worst.map(|w| w.0.as_str()).unwrap_or("?")
+            )
+        } else {
+            let first: String = j
+                .ours
+                .reasons
+                .first()
+                .map(|r| {
+                    r.split(':')
+                        .nth(1)
+                        .unwrap_or(r)
+                        .trim()
+                        .chars()
+                        .take(40)
+                        .collect()
+                })
+                .unwrap_or_default();
+            format!("verdict: we fail, MuJoCo passes ({:?}; {first})", j.kind)
+        });
+    }
+    if j.rest_agrees == Some(false) {
+        let (name, _, _) = &j.rest_drifts[0];
+        return Some(format!("rest: {name} moves in MuJoCo ({:?})", j.kind));
+    }
+    None
+}
+
+/// Totals of judged scenes.
+pub fn summary(js: &[Judged]) -> Summary {
+    let mut s = Summary {
+        scenes: js.len(),
+        ..Default::default()
+    };
+    let mut drift_mm = Vec::new();
+    let mut drift_deg = Vec::new();
+    for j in js {
+        s.we_pass += j.ours.passed as usize;
+        s.mujoco_pass += j.mujoco.passed as usize;
+        s.verdict_agree += j.verdict_agrees as usize;
+        s.marginal += j.marginal as usize;
+        if let Some(a) = j.rest_agrees {
+            s.rest_judged += 1;
+            s.rest_agree += a as usize;
+            for b in &j.ours.bodies {
+                if let Some(m) = j.mujoco.bodies.get(&b.name) {
+                    drift_mm.push(m.from_settled_m * 1e3);
+                    drift_deg.push(m.from_settled_deg);
+                }
+            }
+        }
+        if let Some(c) = cause(j) {
+            *s.causes.entry(c).or_default() += 1;
+        }
+        s.settle_mean_s += j.ours.seconds / js.len().max(1) as f64;
+        s.settle_worst_s = s.settle_worst_s.max(j.ours.seconds);
+    }
+    let mean = |v: &[f64]| v.iter().sum::<f64>() / v.len().max(1) as f64;
+    let worst = |v: &[f64]| v.iter().cloned().fold(0.0, f64::max);
+    s.drift_mean_mm = mean(&drift_mm);
+    s.drift_worst_mm = worst(&drift_mm);
+    s.drift_mean_deg = mean(&drift_deg);
+    s.drift_worst_deg = worst(&drift_deg);
+    s
+}

@@ -1,0 +1,331 @@
+//! Physical validation of a composed scene with Rapier (f64): the settle test.
+//!
+//! A composed scene places objects at poses chosen by a generator: millimetre gaps, round bottoms
+//! that still have to rock into place. Those poses are not rest poses, so the check runs in two
+//! phases on a Rapier world (floor at z = 0, to [`FLOOR_GAP`], gravity along −z, one dynamic or
+//! fixed body per object, one convex collider per hull, the exported mass properties):
+//!
+//! 1. **Settle**: simulate from the composed pose until every dynamic body sleeps (capped). The
+//!    drift from the composed pose (centre-of-mass displacement, rotation angle) must stay small
+//!    relative to the object's size, and an object must still touch what it was resting in or on.
+//!    A large rotation counts only if it moved the object's shape, not a pen's roll about its
+//!    own axis (see [`SettleOptions::max_settle_rotation_deg`]).
+//! 2. **Rest**: from the settled state, with sleeping disabled so that creep cannot hide behind
+//!    the sleep heuristic, simulate some more: every object must stay put, and the contact
+//!    penetration, measured with exact f64 convex queries (not Rapier's possibly recycled contact
+//!    distances), must stay below a tolerance.
+//!
+//! The API is independent of file formats: callers build [`SimBody`]s from whatever they export.
+//! Everything is deterministic: the same input gives a bitwise-identical [`SettleReport`].
+
+use crate::mesh::{Mesh, P3};
+use nalgebra::{Isometry3, Matrix3, Quaternion, Rotation3, Translation3, UnitQuaternion, Vector3};
+use rapier3d_f64::math::{Pose, Real, Rotation, Vector};
+use rapier3d_f64::parry::bounding_volume::{Aabb, BoundingVolume};
+use rapier3d_f64::parry::query;
+use rapier3d_f64::parry::shape::Shape;
+use rapier3d_f64::prelude::{
+    ColliderBuilder, ColliderHandle, MassProperties, NarrowPhase, PhysicsWorld, RigidBodyBuilder,
+    RigidBodyHandle,
+};
+use serde::Serialize;
+
+mod fresh;
+pub mod probe;
+mod settle;
+mod world;
+
+pub use settle::{settle, simulate};
+pub use world::rapier_mass_properties;
+#[cfg(test)]
+use world::Sim;
+
+/// Name used for the floor in support lists and reasons.
+pub const FLOOR: &str = "floor";
+
+/// One object of the scene as the simulator sees it.
+#[derive(Clone, Debug)]
+pub struct SimBody {
+    /// Unique name, used in reports.
+    pub name: String,
+    /// World pose of the body frame (the frame of `hulls` and `com`).
+    pub pose: Isometry3<f64>,
+    /// Convex hulls, vertices in the body frame, metres. Each becomes one convex collider (the
+    /// convex hull of its vertices; triangles are not used).
+    pub hulls: Vec<Mesh>,
+    /// Mass in kg (ignored for fixed bodies).
+    pub mass: f64,
+    /// Centre of mass in the body frame.
+    pub com: P3,
+    /// Full symmetric inertia tensor about the centre of mass, body-frame axes (kg·m²).
+    pub inertia: Matrix3<f64>,
+    /// Coulomb friction coefficient of the object's surface.
+    pub friction: f64,
+    /// Fixed in space (a table, a wall) instead of dynamic.
+    pub fixed: bool,
+}
+
+/// Simulation parameters and pass/fail thresholds. Distances in metres, angles in degrees.
+#[derive(Clone, Debug, Serialize)]
+pub struct SettleOptions {
+    /// Fixed time step (s).
+    pub dt: f64,
+    /// Rapier solver iterations per step.
+    pub solver_iterations: usize,
+    /// Gravitational acceleration along −z (m/s²).
+    pub gravity: f64,
+    /// Cap on the settle phase (s): it ends earlier when every dynamic body sleeps.
+    pub settle_max_time: f64,
+    /// Length of the rest phase (s).
+    pub rest_time: f64,
+    /// Restitution of every collider (floor included).
+    pub restitution: f64,
+    /// Friction coefficient of the floor (combined with a body's by averaging, Rapier's default).
+    pub floor_friction: f64,
+    /// A body may sleep once its farthest point moves slower than this (m/s)...
+    pub sleep_linear_threshold: f64,
+    /// ...for this long (s).
+    pub sleep_time: f64,
+    /// Natural frequency (Hz) of the soft contact constraints between dynamic bodies. Rapier's
+    /// default is 30 Hz for its 60 Hz step; we keep that ratio (half the step rate). At 30 Hz
+    /// with a 240 Hz step a faceted ball resting on its pole vertex in a dynamic bowl kept
+    /// circling for seconds (measured; 90 Hz and up: it settles).
+    pub contact_frequency: f64,
+    /// Natural frequency (Hz) of contacts with fixed bodies and the floor (Rapier: twice the
+    /// dynamic one).
+    pub static_contact_frequency: f64,
+    /// Linear damping of every dynamic body (1/s).
+    pub linear_damping: f64,
+    /// Angular damping of every dynamic body (1/s), a crude stand-in for rolling resistance
+    /// (which Rapier does not model). 0 by default: it did not stop the faceted-ball creep it
+    /// was meant for (see the module tests) and it slows genuine toppling.
+    pub angular_damping: f64,
+    /// Speed (m/s) of the farthest point of every dynamic body due to a small deterministic
+    /// rotation kick at the start of the settle phase, about a fixed oblique axis. A composed
+    /// pose that is an unstable balance (a box on its edge, a pen on its tip) is otherwise kept
+    /// forever by a symmetric simulation; the kick makes it fall as it would in the world.
+    /// 0 disables it.
+    pub perturbation_speed: f64,
+    /// Distance (m) below which Rapier creates speculative contacts. Rapier's default is 2 cm
+    /// (tuned for metre-sized bodies); at centimetre scale that pairs nearly every hull of an
+    /// object with every hull of its container.
+    pub prediction_distance: f64,
+    /// Rapier's contact recycling: a pair whose relative pose moved less than
+    /// `contact_recycle_distance` since its last narrow-phase update keeps its contact points.
+    /// Its reported contact distances then go stale, which does not matter here: every
+    /// measurement uses exact queries. On by default with a 0.5 mm distance: 3x faster on the
+    /// 64-hull benchmark, and it stops the creep of a faceted ball on its pole vertex (with it
+    /// off, that ball kept moving 0.4–4 mm per second, depending chaotically on solver settings).
+    pub contact_recycling: bool,
+    /// With recycling on: a pair's contacts are recomputed once its relative pose moved more
+    /// than this (m). Rapier's default, 5 cm, is larger than our objects.
+    pub contact_recycle_distance: f64,
+    /// Settle fails when the centre of mass moves more than this fraction of the body's
+    /// bounding-box diagonal.
+    pub max_relative_drift: f64,
+    /// Settle fails when the body turns more than this (degrees) and the turn moved its shape:
+    /// some hull vertex, turned about the centre of mass, lies farther than
+    /// `max_relative_drift` of the bounding-box diagonal from the unturned hulls (or the other
+    /// way). A turn about an axis the body is nearly symmetric around (a pen rolling about its
+    /// own axis, a ball) leaves the space it takes where it was and is only noted.
+    pub max_settle_rotation_deg: f64,
+    /// Rest fails when the centre of mass moves more than this (m) at any time of the rest phase.
+    pub max_rest_motion: f64,
+    /// Rest fails when the body turns more than this (degrees).
+    pub max_rest_rotation_deg: f64,
+    /// Rest fails when a contact penetrates deeper than this (m) at any step of the rest phase.
+    pub max_rest_penetration: f64,
+    /// The composed pose fails when two objects (or an object and the floor) interpenetrate
+    /// deeper than this (m): the solver would push them apart, which is not a rest state.
+    pub max_initial_penetration: f64,
+    /// Two bodies closer than this (m) touch; at the composed pose this defines supports.
+    pub support_distance: f64,
+    /// After settling a body still touches a support when closer than `support_distance` plus
+    /// this margin (m).
+    pub support_release_margin: f64,
+    /// A touching body is a support only when the contact normal pointing from it to the
+    /// supported body has at least this upward (z) component (0.1 ≈ 6° above horizontal): side
+    /// contacts between neighbours are not supports, a mug's rim under a leaning pen is.
+    pub support_min_normal_z: f64,
+    /// The marginal probe ([`probe`]): after the rest phase each dynamic body is rolled by this
+    /// angle (degrees) about a horizontal axis through its lowest point, in four directions; it
+    /// is marginal when it ends turned more than half of it from its rest pose. 0 disables it.
+    pub probe_angle_deg: f64,
+    /// How long (s) each of the four probes runs before the body's turn from its rest pose is
+    /// measured.
+    pub probe_time: f64,
+}
+
+impl Default for SettleOptions {
+    fn default() -> Self {
+        SettleOptions {
+            dt: 1.0 / 240.0,
+            solver_iterations: 4,
+            gravity: 9.81,
+            settle_max_time: 3.0,
+            rest_time: 1.0,
+            restitution: 0.0,
+            floor_friction: 0.8,
+            sleep_linear_threshold: 0.005,
+            sleep_time: 0.5,
+            contact_frequency: 120.0,
+            static_contact_frequency: 240.0,
+            linear_damping: 0.0,
+            angular_damping: 0.0,
+            perturbation_speed: 0.001,
+            prediction_distance: 0.002,
+            contact_recycling: true,
+            contact_recycle_distance: 0.0005,
+            max_relative_drift: 0.10,
+            max_settle_rotation_deg: 30.0,
+            max_rest_motion: 0.001,
+            max_rest_rotation_deg: 1.0,
+            max_rest_penetration: 0.001,
+            max_initial_penetration: 0.001,
+            support_distance: 0.002,
+            support_release_margin: 0.001,
+            support_min_normal_z: 0.1,
+            probe_angle_deg: 0.5,
+            probe_time: 0.3,
+        }
+    }
+}
+
+/// A pose as written in reports: translation (m) and unit quaternion (w, x, y, z).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct PoseRecord {
+    pub translation: [f64; 3],
+    pub quaternion_wxyz: [f64; 4],
+}
+
+impl PoseRecord {
+    pub fn from_isometry(iso: &Isometry3<f64>) -> Self {
+        let q = iso.rotation.quaternion();
+        let t = iso.translation.vector;
+        PoseRecord {
+            translation: [t.x, t.y, t.z],
+            quaternion_wxyz: [q.w, q.i, q.j, q.k],
+        }
+    }
+
+    pub fn isometry(&self) -> Isometry3<f64> {
+        let [w, x, y, z] = self.quaternion_wxyz;
+        Isometry3::from_parts(
+            Translation3::from(Vector3::from(self.translation)),
+            UnitQuaternion::new_normalize(Quaternion::new(w, x, y, z)),
+        )
+    }
+}
+
+/// The verdict on one body.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct BodyReport {
+    pub name: String,
+    pub fixed: bool,
+    /// Pose of the body frame after the settle phase.
+    pub settled_pose: PoseRecord,
+    /// Pose of the body frame after the rest phase.
+    pub final_pose: PoseRecord,
+    /// Diagonal of the body-frame bounding box of all hulls (m).
+    pub bbox_diagonal: f64,
+    /// Centre-of-mass displacement from the composed pose to the settled pose (m).
+    pub settle_displacement: f64,
+    /// Rotation angle from the composed pose to the settled pose (degrees).
+    pub settle_rotation_deg: f64,
+    /// When `settle_rotation_deg` exceeds the limit: how far that turn alone, about the centre
+    /// of mass, moved the body's shape (m), the largest distance from a turned hull vertex to
+    /// the unturned hulls or from an unturned vertex to the turned hulls. Small for a turn
+    /// about an axis of near symmetry. `None` when the rotation is within the limit.
+    pub settle_shape_shift: Option<f64>,
+    /// `settle_displacement / bbox_diagonal`.
+    pub relative_drift: f64,
+    /// Largest centre-of-mass displacement from the settled pose during the rest phase (m).
+    pub rest_displacement: f64,
+    /// Largest rotation from the settled pose during the rest phase (degrees).
+    pub rest_rotation_deg: f64,
+    /// Deepest contact penetration involving this body during the rest phase (m, ≥ 0), exact.
+    pub rest_max_penetration: f64,
+    /// What it penetrated deepest during the rest phase (a body name or `floor`).
+    pub rest_max_penetration_with: Option<String>,
+    /// Deepest penetration at the composed pose (m, ≥ 0).
+    pub initial_penetration: f64,
+    pub initial_penetration_with: Option<String>,
+    /// What the body rests in or on at the composed pose (`floor` and/or body names).
+    pub supports_at_start: Vec<String>,
+    /// Everything the body touches after settling (`floor` and/or body names).
+    pub touching_after_settle: Vec<String>,
+    /// It started on other bodies and touches none of them after settling.
+    pub left_supports: bool,
+    /// It started on other bodies (not the floor) and ended on the floor.
+    pub ended_on_floor: bool,
+    pub passed: bool,
+    /// Why it failed (empty when it passed).
+    pub reasons: Vec<String>,
+    /// Observations that do not fail the body.
+    pub notes: Vec<String>,
+    /// The rest pose is only balanced: rolled 0.5° off it, the body did not come back (see
+    /// [`probe`]). Other engines may not hold it; it does not fail the body.
+    pub marginal: bool,
+    /// Largest drift from the rest pose at the end of the four probes (m, degrees); 0 with the
+    /// probe off.
+    pub probe_displacement: f64,
+    pub probe_rotation_deg: f64,
+}
+
+/// The outcome of [`settle`].
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct SettleReport {
+    pub passed: bool,
+    pub bodies: Vec<BodyReport>,
+    /// Simulated time until every dynamic body slept; `None` if they did not within the cap.
+    pub time_to_sleep: Option<f64>,
+    pub settle_steps: usize,
+    pub rest_steps: usize,
+    /// `settle_steps + rest_steps`.
+    pub steps: usize,
+    pub dt: f64,
+    /// Scene-level observations that do not fail the scene.
+    pub warnings: Vec<String>,
+    /// Names of the bodies whose rest pose is marginal (see [`BodyReport::marginal`]).
+    pub marginal: Vec<String>,
+}
+
+/// Poses of every body over time, from [`simulate`].
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Trajectory {
+    pub names: Vec<String>,
+    pub dt: f64,
+    pub steps: usize,
+    /// Simulated time of each frame (s).
+    pub times: Vec<f64>,
+    /// `frames[k][i]`: pose of body `i` at `times[k]`.
+    pub frames: Vec<Vec<PoseRecord>>,
+}
+
+/// Why a scene cannot be simulated.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum PhysicsError {
+    #[error("body '{body}': {message}")]
+    InvalidBody { body: String, message: String },
+    #[error("invalid settle options: {0}")]
+    InvalidOptions(String),
+}
+
+fn body_error(body: &SimBody, message: impl Into<String>) -> PhysicsError {
+    PhysicsError::InvalidBody {
+        body: body.name.clone(),
+        message: message.into(),
+    }
+}
+
+/// How far below z = 0 the floor's top face lies (m). Prepared scenes rest on z = 0, and a
+/// hull's lowest vertex ends up there only to f64 rounding: 1.4e-17 m *above* it, say. At such
+/// a separation, below GJK's tolerance, parry's contact query gave a hull touching the floor
+/// at a sharp vertex (the apex of a basket floor's pie slice) a normal pointing up out
+/// of the floor, in about half the cases; Rapier then slid the fixture basket 2.4 mm and rolled
+/// its fruits out. Exactly at 0, below it, or 1e-12 m above it, the normals are right. 10 nm is
+/// far above the rounding and far below anything the checks measure.
+pub const FLOOR_GAP: f64 = 1e-8;
+
+#[cfg(test)]
+mod tests;
