@@ -317,6 +317,7 @@ pub fn run(args: &[String]) {
     println!("| pair | object | ≤ 2 % | ≤ 5 % | mean ADD-S | worst ADD-S | mean scale err | worst scale err | winning stages |");
     println!("|---:|---|---:|---:|---:|---:|---:|---:|---|");
     let mut keys: Vec<(usize, String)> = recs.iter().map(|r| (r.pair, r.id.clone())).collect();
+    keys.sort();
     keys.dedup();
     for (k, id) in keys {
         let rs: Vec<&Record> = recs
