@@ -4,6 +4,7 @@
 use crate::mesh::{triangle_area, VisualMesh, P3, V3};
 use crate::rng::Rng;
 use nalgebra::Matrix4;
+use std::sync::{Arc, Mutex};
 
 /// Surface samples of one mesh.
 #[derive(Clone, Debug, Default)]
@@ -34,6 +35,46 @@ impl Image {
             self.px[i + 1] as f64 / 255.0,
             self.px[i + 2] as f64 / 255.0,
         ]
+    }
+}
+
+/// Decoded textures of the last few meshes sampled, by their shared bytes: composing samples
+/// an object, its guidance part (the same texture) and the object again, and a 4096² JPEG
+/// takes ~0.2 s to decode. The cache holds a clone of each key, so an address is never reused
+/// while cached.
+type Cached = Vec<(Arc<Vec<u8>>, Arc<Image>)>;
+static DECODED: Mutex<Cached> = Mutex::new(Vec::new());
+const DECODED_KEEP: usize = 4;
+
+fn decoded(bytes: &Arc<Vec<u8>>) -> Option<Arc<Image>> {
+    if let Some(hit) = DECODED
+        .lock()
+        .ok()?
+        .iter()
+        .find(|(k, _)| Arc::ptr_eq(k, bytes))
+        .map(|(_, img)| img.clone())
+    {
+        return Some(hit);
+    }
+    let img = image::load_from_memory(bytes).ok()?.to_rgb8();
+    let img = Arc::new(Image {
+        w: img.width(),
+        h: img.height(),
+        px: img.into_raw(),
+    });
+    if let Ok(mut cache) = DECODED.lock() {
+        if cache.len() >= DECODED_KEEP {
+            cache.remove(0);
+        }
+        cache.push((bytes.clone(), img.clone()));
+    }
+    Some(img)
+}
+
+/// Empty the decoded-texture cache (benchmarks time a cold start with it).
+pub fn forget_decoded() {
+    if let Ok(mut c) = DECODED.lock() {
+        c.clear();
     }
 }
 
@@ -68,18 +109,13 @@ impl Cloud {
         if tris.is_empty() || n == 0 {
             return out;
         }
-        let images: Vec<Option<Image>> = mesh
+        let images: Vec<Option<Arc<Image>>> = mesh
             .parts
             .iter()
             .map(|p| {
                 let tex = p.material.texture.as_ref()?;
                 p.uvs.as_ref()?;
-                let img = image::load_from_memory(&tex.bytes).ok()?.to_rgb8();
-                Some(Image {
-                    w: img.width(),
-                    h: img.height(),
-                    px: img.into_raw(),
-                })
+                decoded(&tex.bytes)
             })
             .collect();
         out.points.reserve(n);

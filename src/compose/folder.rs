@@ -160,6 +160,7 @@ pub fn registration_json(
             i.name.clone(),
             json!({
                 "method": r.method,
+                "pose_stage": r.pose_stage,
                 "scale": t.scale,
                 "rotation": (0..3).map(|a| (0..3).map(|b| rm[(a, b)]).collect::<Vec<f64>>()).collect::<Vec<_>>(),
                 "translation": [t.translation.x, t.translation.y, t.translation.z],

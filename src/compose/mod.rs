@@ -23,10 +23,13 @@ pub mod colour;
 pub mod features;
 pub mod folder;
 pub mod global;
+pub mod guard;
 pub mod icp;
 pub mod kdtree;
 pub mod obb;
 pub mod occlusion;
+pub mod plane_icp;
+pub mod realistic;
 pub mod refine;
 pub mod scale;
 pub mod sdf;
@@ -129,6 +132,11 @@ pub struct ObjectResult {
     pub transform: Similarity,
     /// Stages that produced the transform, e.g. `obb+fpfh_ransac+trimmed_icp+collision_refine`.
     pub method: String,
+    /// The stage whose pose was returned (the last stage that did not make the fit worse).
+    pub pose_stage: String,
+    /// Every stage's fit (mean truncated guidance-to-surface distance) and whether its pose
+    /// was taken ([`guard`]).
+    pub stages: Vec<guard::StageFit>,
     /// Silhouette area of the guidance part (guidance units²).
     pub silhouette_area: f64,
     pub initial_scale: f64,
@@ -252,21 +260,23 @@ fn name_seed(seed: u64, name: &str) -> u64 {
 
 /// Register one object onto its guidance part (steps 2–4). `occlusion` holds the other objects
 /// of the scene, which hide parts of this one ([`Occlusion`]).
+#[allow(clippy::too_many_arguments)]
 fn register(
     object: &Cloud,
+    object_tree: &KdTree,
+    spacing: f64,
     guidance: &Cloud,
     occlusion: Option<&Occlusion<'_>>,
     method: Method,
     seed: u64,
-) -> (Similarity, String, f64, f64, f64, usize, bool) {
-    let object_tree = KdTree::new(&object.points);
+) -> Registered {
     let guidance_tree = KdTree::new(&guidance.points);
     let object_obb = Obb::of_points(&object.points);
     let guidance_obb = Obb::of_points(&guidance.points);
     let scale0 = obb::scale_ratio(&object_obb, &guidance_obb);
     let p = Problem {
         object,
-        object_tree: &object_tree,
+        object_tree,
         guidance,
         guidance_tree: &guidance_tree,
         object_obb,
@@ -323,7 +333,7 @@ fn register(
             weight: COLOUR_WEIGHT * object.diagonal(),
         }
     } else {
-        icp::Matcher::Geometry(&object_tree)
+        icp::Matcher::Geometry(object_tree)
     };
     let init = if hyps.len() == 1 {
         hyps[0]
@@ -333,14 +343,31 @@ fn register(
             .unwrap_or(hyps[0])
     };
     let g_icp = guidance.subsample(1500);
-    let (t, rms) = trimmed_icp(&object.points, &matcher, &g_icp, init, &icp);
+    // The guard: every stage starts from the best pose so far and is kept only when it fits the
+    // guidance at least as well ([`guard`]).
+    let mut guard = guard::Guard::new(
+        object,
+        object_tree,
+        spacing,
+        guidance.subsample(1000).points,
+        init,
+        if n_hyp == 1 { stages } else { "global" },
+    );
+    let (t, rms) = trimmed_icp(&object.points, &matcher, &g_icp, guard.pose(), &icp);
+    guard.offer("trimmed_icp", t);
+    let mut rms = rms;
     let probe_g = global::probes(guidance.len(), 700);
     let probe_o = global::probes(object.len(), 700);
-    let (t, rms) = if matches!(method, Method::IcpOnly | Method::RansacIcp) {
-        (t, rms)
-    } else {
+    if !matches!(method, Method::IcpOnly | Method::RansacIcp) {
         let (t, _) = scale::search(
-            &p, &matcher, &g_icp, t, &icp, use_colour, &probe_g, &probe_o,
+            &p,
+            &matcher,
+            &g_icp,
+            guard.pose(),
+            &icp,
+            use_colour,
+            &probe_g,
+            &probe_o,
         );
         // Free ICP again, its scale now held within ±1.5% of the chosen one.
         let near = IcpOptions {
@@ -348,21 +375,61 @@ fn register(
             scale_hi: t.scale * 1.015,
             ..icp
         };
-        trimmed_icp(&object.points, &matcher, &g_icp, t, &near)
-    };
+        let (t, r) = trimmed_icp(&object.points, &matcher, &g_icp, t, &near);
+        if guard.offer("scale_search", t) {
+            rms = r;
+        }
+        // The local fit all the way in: robust point-to-plane ICP, the scale from how the
+        // surfaces overlap (within ±5 % of the current one, inside the global bounds).
+        let s0 = guard.pose().scale;
+        let pl = plane_icp::PlaneIcpOptions {
+            iterations: 30,
+            keep: 0.85,
+            huber: 1.5,
+            scale: true,
+            scale_lo: (s0 / 1.05).max(icp.scale_lo),
+            scale_hi: (s0 * 1.05).min(icp.scale_hi),
+            tolerance: 1e-6 * p.guidance_diagonal(),
+        };
+        let (t, r) = plane_icp::plane_icp(object, &matcher, &g_icp, guard.pose(), &pl);
+        if guard.offer("point_to_plane", t) {
+            rms = r;
+        }
+    }
+    let t = guard.pose();
     let score = global::score(&p, &t, use_colour, &probe_g, &probe_o);
-    (
-        t,
-        format!(
-            "{stages}+trimmed_icp{}",
-            if use_colour { "+colour" } else { "" }
+    Registered {
+        transform: t,
+        method: format!(
+            "{stages}+trimmed_icp{}{}",
+            if use_colour { "+colour" } else { "" },
+            if matches!(method, Method::IcpOnly | Method::RansacIcp) {
+                ""
+            } else {
+                "+scale_search+point_to_plane"
+            }
         ),
         scale0,
         score,
         rms,
-        n_hyp,
-        use_colour,
-    )
+        hypotheses: n_hyp,
+        colour_used: use_colour,
+        pose_stage: guard.stage().to_string(),
+        stages: guard.log().to_vec(),
+    }
+}
+
+/// What [`register`] found for one object.
+struct Registered {
+    transform: Similarity,
+    method: String,
+    scale0: f64,
+    score: f64,
+    rms: f64,
+    hypotheses: usize,
+    colour_used: bool,
+    pose_stage: String,
+    stages: Vec<guard::StageFit>,
 }
 
 /// Compose the objects (steps 1–5). Errors only on unusable input (an empty mesh).
@@ -442,8 +509,20 @@ pub fn compose(inputs: &[ObjectInput], o: &ComposeOptions) -> Result<Composition
                 None => o,
             }
         });
-        let (mut t, mut method, scale0, score, rms, n_hyp, colour_used) =
-            register(&object, guidance, occlusion.as_ref(), o.method, seed);
+        let object_tree = KdTree::new(&object.points);
+        let spacing = guard::spacing(&inp.visual, object.len());
+        let reg = register(
+            &object,
+            &object_tree,
+            spacing,
+            guidance,
+            occlusion.as_ref(),
+            o.method,
+            seed,
+        );
+        let (mut t, mut method, colour_used) = (reg.transform, reg.method.clone(), reg.colour_used);
+        let mut pose_stage = reg.pose_stage.clone();
+        let mut stages = reg.stages.clone();
         let mut refinement = None;
         // The object's welded mesh, built once for the dense check and the anchor field.
         let geometry = std::cell::OnceCell::new();
@@ -470,7 +549,8 @@ pub fn compose(inputs: &[ObjectInput], o: &ComposeOptions) -> Result<Composition
                     matcher: &matcher,
                     keep: 0.8,
                 };
-                let mut r = refine(&sub.points, &target, t, f, unit, &o.refine);
+                let start = t;
+                let mut r = refine(&sub.points, &target, start, f, unit, &o.refine);
                 // Dense check: 700 samples miss thin parts between them (a shoe's edge stayed
                 // 1.5 mm inside the tray). The object's vertices within the clearance band join
                 // the samples for a second pass that removes what is left while moving the
@@ -496,7 +576,36 @@ pub fn compose(inputs: &[ObjectInput], o: &ComposeOptions) -> Result<Composition
                         ..r2
                     };
                 }
-                t = r.transform;
+                // The guard: leaving the anchor may cost the fit what the move out of it costs
+                // (the depth plus the clearance), no more. A refinement that drifts further is
+                // replaced by the smallest move out of collision from the registered pose; if
+                // that too fits worse, the registered pose stays.
+                let mut guard = guard::Guard::new(
+                    &object,
+                    &object_tree,
+                    spacing,
+                    guidance.subsample(1000).points,
+                    start,
+                    &pose_stage,
+                );
+                guard.with_allowance(r.penetration_before + 2.0 * o.refine.epsilon * unit);
+                if !guard.offer("collision_refine", r.transform) {
+                    let m = start.matrix();
+                    let mut pts = sub.points.clone();
+                    pts.extend(
+                        geometry()
+                            .vertices
+                            .iter()
+                            .filter(|&&v| f.eval(&m.transform_point(&v)).0 < band),
+                    );
+                    let r2 = refine(&pts, &Target::InitialPose, start, f, unit, &o.refine);
+                    if guard.offer("collision_minimal", r2.transform) {
+                        r = r2;
+                    }
+                }
+                t = guard.pose();
+                pose_stage = guard.stage().to_string();
+                stages.extend(guard.log().iter().skip(1).cloned());
                 method.push_str("+collision_refine");
                 refinement = Some(RefineReport::from(&r));
             }
@@ -516,12 +625,14 @@ pub fn compose(inputs: &[ObjectInput], o: &ComposeOptions) -> Result<Composition
         results.push(ObjectResult {
             name: inp.name.clone(),
             transform: t,
+            pose_stage,
+            stages,
             method,
             silhouette_area: areas[i],
-            initial_scale: scale0,
-            score,
-            icp_rms: rms,
-            hypotheses: n_hyp,
+            initial_scale: reg.scale0,
+            score: reg.score,
+            icp_rms: reg.rms,
+            hypotheses: reg.hypotheses,
             colour_used,
             refinement,
         });

@@ -1,0 +1,213 @@
+//! The guard: a stage's pose replaces the current one only when it does not fit the guidance
+//! worse ([`super::plane_icp::surface_fit`], the mean truncated distance of guidance points to
+//! the posed object's surface). Each offer is logged, so the report says which stage's pose won
+//! and what every stage's fit was.
+//!
+//! Entry point: [`Guard`] (`new` with the first pose, `offer` each later stage's pose, then
+//! `pose`, `stage`, `log`).
+
+use super::cloud::Cloud;
+use super::kdtree::KdTree;
+use super::plane_icp::surface_fit;
+use crate::mesh::{triangle_area, VisualMesh, P3};
+use crate::pose::Similarity;
+use serde::Serialize;
+
+/// One stage's offer.
+#[derive(Clone, Debug, Serialize)]
+pub struct StageFit {
+    pub stage: String,
+    /// Mean truncated guidance-to-surface distance at the stage's pose (guidance units).
+    pub fit: f64,
+    pub accepted: bool,
+}
+
+/// Keeps the best-fitting pose of the stages offered to it.
+pub struct Guard<'a> {
+    object: &'a Cloud,
+    tree: &'a KdTree,
+    spacing: f64,
+    probe: Vec<P3>,
+    /// Distances are truncated at `cap_fraction` × the object's diagonal at the pose's scale.
+    cap_fraction: f64,
+    /// A later pose may be worse by this much (guidance units) and still be taken.
+    allowance: f64,
+    best: Similarity,
+    best_fit: f64,
+    stage: String,
+    log: Vec<StageFit>,
+}
+
+/// Mean sample spacing of `n` samples on `visual`'s surface (object units).
+pub fn spacing(visual: &VisualMesh, n: usize) -> f64 {
+    let area: f64 = visual
+        .parts
+        .iter()
+        .flat_map(|p| {
+            p.triangles
+                .iter()
+                .map(|t| triangle_area(&t.map(|k| p.positions[k as usize])))
+        })
+        .sum();
+    (area / n.max(1) as f64).sqrt()
+}
+
+impl<'a> Guard<'a> {
+    /// A guard over `object` (samples with normals, its tree, their `spacing`) and the guidance
+    /// points `probe`, starting from the pose `start` of stage `stage`.
+    pub fn new(
+        object: &'a Cloud,
+        tree: &'a KdTree,
+        spacing: f64,
+        probe: Vec<P3>,
+        start: Similarity,
+        stage: &str,
+    ) -> Guard<'a> {
+        let mut g = Guard {
+            object,
+            tree,
+            spacing,
+            probe,
+            cap_fraction: 0.03,
+            allowance: 0.0,
+            best: start,
+            best_fit: f64::INFINITY,
+            stage: stage.to_string(),
+            log: Vec::new(),
+        };
+        g.best_fit = g.fit(&start);
+        g.log.push(StageFit {
+            stage: stage.to_string(),
+            fit: g.best_fit,
+            accepted: true,
+        });
+        g
+    }
+
+    /// The fit of pose `t` (lower is better).
+    pub fn fit(&self, t: &Similarity) -> f64 {
+        let cap = self.cap_fraction * t.scale * self.object.diagonal();
+        surface_fit(self.object, self.tree, self.spacing, &self.probe, t, cap)
+    }
+
+    /// Allow the next offers to be worse by `allowance` (guidance units): a stage with another
+    /// aim (moving out of collision) may cost a little fit, never more.
+    pub fn with_allowance(&mut self, allowance: f64) -> &mut Self {
+        self.allowance = allowance;
+        self
+    }
+
+    /// Offer stage `stage`'s pose; taken when its fit is not worse than the current pose's (plus
+    /// the allowance). Returns whether it was taken.
+    pub fn offer(&mut self, stage: &str, t: Similarity) -> bool {
+        let f = self.fit(&t);
+        let ok = f.is_finite() && f <= self.best_fit + self.allowance;
+        self.log.push(StageFit {
+            stage: stage.to_string(),
+            fit: f,
+            accepted: ok,
+        });
+        if ok {
+            self.best = t;
+            self.best_fit = f;
+            self.stage = stage.to_string();
+        }
+        ok
+    }
+
+    pub fn pose(&self) -> Similarity {
+        self.best
+    }
+    pub fn best_fit(&self) -> f64 {
+        self.best_fit
+    }
+    /// The stage whose pose is current.
+    pub fn stage(&self) -> &str {
+        &self.stage
+    }
+    pub fn log(&self) -> &[StageFit] {
+        &self.log
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::compose::icp::Matcher;
+    use crate::compose::plane_icp::{plane_icp, PlaneIcpOptions};
+    use crate::mesh::V3;
+    use crate::rng::Rng;
+    use nalgebra::UnitQuaternion;
+
+    /// A refinement that diverges: the guidance is a box's surface plus a dense cluster of
+    /// outliers off one corner, and the ICP runs without trimming or robust weights, so it is
+    /// dragged towards the cluster. The guard must keep the start, whose fit it measures better,
+    /// and never hold a pose worse than the start.
+    #[test]
+    fn guard_never_returns_a_worse_fit_when_refinement_diverges() {
+        let mesh = crate::shapes::cuboid(V3::new(1.0, 0.6, 0.3));
+        let vis = crate::shapes::visual(
+            &mesh,
+            crate::shapes::UvProjection::Box { tile: 1.0 },
+            Default::default(),
+        );
+        let obj = Cloud::sample(&vis, 4000, 1);
+        let tree = KdTree::new(&obj.points);
+        let truth = Similarity {
+            scale: 1.5,
+            rotation: UnitQuaternion::from_euler_angles(0.2, 0.5, -0.3),
+            translation: V3::new(1.0, 2.0, -1.0),
+        };
+        let mut g = Cloud::sample(&vis, 1500, 2).transformed(&truth.matrix());
+        let mut rng = Rng::new(9);
+        let corner = truth.matrix().transform_point(&P3::new(1.2, 0.8, 0.6));
+        for _ in 0..900 {
+            g.points
+                .push(corner + V3::new(rng.normal(), rng.normal(), rng.normal()) * 0.1);
+        }
+        g.colours = vec![[0.5; 3]; g.points.len()];
+        g.normals = vec![V3::z(); g.points.len()];
+        let start = truth;
+        let o = PlaneIcpOptions {
+            keep: 1.0,
+            huber: 1e12,
+            scale_lo: 0.5,
+            scale_hi: 3.0,
+            ..Default::default()
+        };
+        let (diverged, _) = plane_icp(&obj, &Matcher::Geometry(&tree), &g, start, &o);
+        // It did diverge (the premise of the test), by an independent measure: the pose error.
+        let err = (diverged.translation - truth.translation).norm();
+        assert!(err > 0.05, "the unguarded ICP did not diverge ({err})");
+        let mut guard = Guard::new(
+            &obj,
+            &tree,
+            spacing(&vis, 4000),
+            g.points.clone(),
+            start,
+            "start",
+        );
+        let f0 = guard.best_fit();
+        let taken = guard.offer("plane_icp", diverged);
+        assert!(!taken, "a worse pose was taken");
+        assert_eq!(guard.stage(), "start");
+        assert_eq!(guard.pose().translation, start.translation);
+        assert!(guard.best_fit() <= f0);
+        // A better pose is taken: from a start 2 cm off, the guard moves to the truth.
+        let off = Similarity {
+            translation: truth.translation + V3::new(0.02, 0.0, 0.0),
+            ..truth
+        };
+        let mut guard = Guard::new(
+            &obj,
+            &tree,
+            spacing(&vis, 4000),
+            g.points.clone(),
+            off,
+            "start",
+        );
+        assert!(guard.offer("icp", truth));
+        assert_eq!(guard.stage(), "icp");
+        assert_eq!(guard.log().len(), 2);
+    }
+}
