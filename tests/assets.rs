@@ -3,80 +3,13 @@
 //! verdict on the MJCF cases, our own exports read back, and the CI outputs.
 //! Needs Python with `pybullet` (for pybullet_data) and `mujoco` (tests/python/requirements.txt).
 
+#[path = "asset_cases/mod.rs"]
+mod cases;
 mod common;
+use cases::*;
 use common::*;
 use interact3d::validate::asset::{check_path, AssetCheckOptions};
-use interact3d::validate::finding::{AssetReport, Finding};
-use std::path::{Path, PathBuf};
-
-fn pybullet_data() -> PathBuf {
-    let out = std::process::Command::new(python())
-        .args([
-            "-c",
-            "import pybullet_data;print(pybullet_data.getDataPath())",
-        ])
-        .output()
-        .expect("python3 with pybullet (tests/python/requirements.txt)");
-    assert!(out.status.success(), "pybullet_data not installed");
-    PathBuf::from(String::from_utf8_lossy(&out.stdout).trim())
-}
-
-fn check(p: &Path) -> AssetReport {
-    check_path(p, p.to_str().unwrap(), &AssetCheckOptions::default())
-}
-
-fn find<'a>(r: &'a AssetReport, id: &str) -> Vec<&'a Finding> {
-    r.findings.iter().filter(|f| f.check == id).collect()
-}
-
-fn ids(r: &AssetReport) -> Vec<&str> {
-    r.findings.iter().map(|f| f.check.as_str()).collect()
-}
-
-fn apple() -> String {
-    shared()
-        .join("datasets/objects/ycb/013_apple/textured.obj")
-        .canonicalize()
-        .unwrap()
-        .display()
-        .to_string()
-}
-
-fn mug() -> PathBuf {
-    shared()
-        .join("datasets/objects/gso/ACE_Coffee_Mug_Kristen_16_oz_cup/model.obj")
-        .canonicalize()
-        .unwrap()
-}
-
-fn write(dir: &Path, name: &str, text: &str) -> PathBuf {
-    let p = dir.join(name);
-    std::fs::write(&p, text).unwrap();
-    p
-}
-
-/// A one-link URDF: `inertial` and `geometry` blocks as given.
-fn urdf(inertial: &str, visual: &str, collision: &str) -> String {
-    format!(
-        "<?xml version=\"1.0\"?>\n<robot name=\"t\">\n  <link name=\"obj\">\n{inertial}\n    <visual><geometry>{visual}</geometry></visual>\n    <collision><geometry>{collision}</geometry></collision>\n  </link>\n</robot>\n"
-    )
-}
-
-fn inertial(mass: f64, i: [f64; 3], com: [f64; 3]) -> String {
-    format!(
-        "    <inertial>\n      <origin xyz=\"{} {} {}\"/>\n      <mass value=\"{mass}\"/>\n      <inertia ixx=\"{}\" iyy=\"{}\" izz=\"{}\" ixy=\"0\" ixz=\"0\" iyz=\"0\"/>\n    </inertial>",
-        com[0], com[1], com[2], i[0], i[1], i[2]
-    )
-}
-
-/// Exact inertia of a solid box of mass `m` and full extents `e` about its centre.
-fn box_inertia(m: f64, e: [f64; 3]) -> [f64; 3] {
-    [
-        m * (e[1] * e[1] + e[2] * e[2]) / 12.0,
-        m * (e[0] * e[0] + e[2] * e[2]) / 12.0,
-        m * (e[0] * e[0] + e[1] * e[1]) / 12.0,
-    ]
-}
+use std::path::Path;
 
 #[test]
 fn pybullet_data_real_files() {
@@ -92,10 +25,14 @@ fn pybullet_data_real_files() {
             10.min(p[0].line.max(8)),
             "{f}: line of <inertial>"
         );
+        // Errors: only the duck's settle. Its mesh is Y-up and the URDF does not turn it, so it
+        // lies on its side; with the inertia its shape implies it rolls over by 90° (so does
+        // PyBullet with the same moments: tests/asset_judges.rs).
         assert!(
-            r.findings
-                .iter()
-                .all(|f| f.severity < interact3d::validate::finding::Severity::Error),
+            r.findings.iter().all(
+                |x| x.severity < interact3d::validate::finding::Severity::Error
+                    || (f == "duck_vhacd.urdf" && x.check == "physics.settle")
+            ),
             "{f}: {:#?}",
             r.findings
         );
@@ -291,49 +228,6 @@ fn geometry_checks() {
     );
 }
 
-/// The mug (a concave collision mesh, welded) and a 1 cm ball placed in its cavity or beside it.
-fn mug_scene(dir: &Path, name: &str, inside: bool) -> PathBuf {
-    let m = interact3d::io::load_visual(&mug(), &Default::default())
-        .unwrap()
-        .geometry();
-    let b = m.aabb().unwrap();
-    let top: Vec<_> = m
-        .vertices
-        .iter()
-        .filter(|v| v.z > b.max.z - 0.004)
-        .collect();
-    let cx = top.iter().map(|v| v.x).sum::<f64>() / top.len() as f64;
-    let cy = top.iter().map(|v| v.y).sum::<f64>() / top.len() as f64;
-    let (x, y, z) = if inside {
-        (cx, cy, b.min.z + 0.5 * (b.max.z - b.min.z))
-    } else {
-        (b.max.x + 0.05, cy, b.min.z + 0.0101)
-    };
-    let xml = format!(
-        r#"<mujoco model="{name}">
-  <compiler angle="radian"/>
-  <asset>
-    <mesh name="mug" file="{}"/>
-  </asset>
-  <worldbody>
-    <geom name="floor" type="plane" size="1 1 0.1" pos="0 0 {}"/>
-    <body name="mug">
-      <geom name="mug_collision" type="mesh" mesh="mug"/>
-    </body>
-    <body name="ball" pos="{x} {y} {z}">
-      <freejoint/>
-      <inertial pos="0 0 0" mass="0.01" diaginertia="4e-7 4e-7 4e-7"/>
-      <geom name="ball_collision" type="sphere" size="0.01"/>
-    </body>
-  </worldbody>
-</mujoco>
-"#,
-        mug().display(),
-        b.min.z
-    );
-    write(dir, &format!("{name}.xml"), &xml)
-}
-
 #[test]
 fn concave_hull_with_a_body_inside_and_mujoco_agrees() {
     let t = tempfile::tempdir().unwrap();
@@ -390,36 +284,6 @@ fn concave_hull_with_a_body_inside_and_mujoco_agrees() {
         mj["motion"]["ball"]["moved"].as_f64().unwrap() < 1e-3,
         "{mj}"
     );
-}
-
-/// Two boxes (MJCF) `gap` apart along x (negative: overlapping), the lower `sink` below the floor.
-fn boxes(dir: &Path, name: &str, gap: f64, sink: f64, tilt_deg: f64) -> PathBuf {
-    let h = 0.025;
-    let xml = format!(
-        r#"<mujoco model="{name}">
-  <worldbody>
-    <geom name="floor" type="plane" size="1 1 0.1"/>
-    <body name="a" pos="0 0 {}">
-      <freejoint/>
-      <geom type="box" size="{h} {h} {h}" density="500"/>
-    </body>
-    <body name="b" pos="{} 0 {}" euler="0 {tilt_deg} 0">
-      <freejoint/>
-      <geom type="box" size="0.01 0.01 0.1" density="500"/>
-    </body>
-  </worldbody>
-</mujoco>
-"#,
-        h - sink,
-        2.0 * h + gap + 0.3,
-        if tilt_deg == 0.0 {
-            0.1
-        } else {
-            0.1 * tilt_deg.to_radians().cos() + 0.01 * tilt_deg.to_radians().sin()
-        }
-    );
-    let _ = 2.0 * h;
-    write(dir, &format!("{name}.xml"), &xml)
 }
 
 #[test]

@@ -1,11 +1,12 @@
 """MuJoCo's own view of an MJCF asset, as JSON on stdout (the judge of tests/assets.rs).
 
-usage: check_asset_mujoco.py MODEL.xml [--seconds S]
+usage: check_asset_mujoco.py MODEL.xml [--seconds S] [--window W]
 
 Reports whether MuJoCo loads the model (and its error if not), the deepest contact between two
 different bodies and between a body and the world's plane after mj_forward (keyframe 0 when the
 model has one), and every free body's centre-of-mass motion (m) and rotation (degrees) over S
-seconds (default 2).
+seconds (default 2), and over the last W of them (`window_motion`, default 1): "does it still
+move once it had time to settle".
 """
 import json
 import math
@@ -18,6 +19,7 @@ import numpy as np
 def main():
     path = sys.argv[1]
     seconds = float(sys.argv[sys.argv.index("--seconds") + 1]) if "--seconds" in sys.argv else 2.0
+    window = float(sys.argv[sys.argv.index("--window") + 1]) if "--window" in sys.argv else 1.0
     try:
         model = mujoco.MjModel.from_xml_path(path)
     except Exception as e:  # MuJoCo refuses the model: say why
@@ -39,21 +41,29 @@ def main():
             and model.jnt_type[model.body_jntadr[b]] == mujoco.mjtJoint.mjJNT_FREE]
     start = {b: (data.xipos[b].copy(), data.xquat[b].copy()) for b in free}
     steps = int(round(seconds / model.opt.timestep))
-    for _ in range(steps):
+    last = steps - int(round(window / model.opt.timestep))
+    before = start
+    for k in range(steps):
+        if k == last:
+            before = {b: (data.xipos[b].copy(), data.xquat[b].copy()) for b in free}
         mujoco.mj_step(model, data)
-    motion = {}
-    for b in free:
-        p0, q0 = start[b]
+
+    def moved(b, frm):
+        p0, q0 = frm[b]
         d = abs(float(np.dot(q0, data.xquat[b])))
-        motion[model.body(b).name] = {
+        return {
             "moved": float(np.linalg.norm(data.xipos[b] - p0)),
             "turned_deg": math.degrees(2.0 * math.acos(min(1.0, d))),
         }
+
+    motion = {model.body(b).name: moved(b, start) for b in free}
+    window_motion = {model.body(b).name: moved(b, before) for b in free}
     print(json.dumps({
         "loads": True,
         "body_penetration": body_pen,
         "floor_penetration": floor_pen,
         "motion": motion,
+        "window_motion": window_motion,
         "finite": bool(np.all(np.isfinite(data.qpos))),
     }))
 
