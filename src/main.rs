@@ -205,6 +205,10 @@ struct ValidateArgs {
     /// Skip the settle and rest tests of URDF/MJCF assets (static checks only).
     #[arg(long)]
     no_physics: bool,
+    /// Check an MJCF object model file (one body, no joint, no floor) welded, as MuJoCo loads
+    /// it alone, instead of as a free object on a ground plane.
+    #[arg(long)]
+    keep_welded: bool,
     #[command(flatten)]
     build: BuildArgs,
     #[command(flatten)]
@@ -665,6 +669,7 @@ fn validate(a: ValidateArgs) -> Result<ExitCode, Error> {
     };
     opts.asset.read.limits = a.limits.limits();
     opts.asset.read.packages = a.packages.clone();
+    opts.asset.read.keep_welded = a.keep_welded;
     opts.asset.physics = !a.no_physics;
     opts.asset.settle = interact3d::physics::SettleOptions {
         perturbation_speed: opts.asset.settle.perturbation_speed,

@@ -213,6 +213,10 @@ pub struct ReadOptions {
     pub limits: Limits,
     /// `package://NAME/...` → `DIR/...` (URDF).
     pub packages: Vec<(String, PathBuf)>,
+    /// MJCF: keep a lone welded body welded. By default an object model file (no joint at all,
+    /// no floor, nothing on the world body but one body tree, as Google Scanned Objects and
+    /// robosuite object files are written) is checked as the free object it is meant to be.
+    pub keep_welded: bool,
 }
 
 /// Read a URDF or MJCF file.

@@ -12,7 +12,9 @@
 //! ≥ 3 hidden), `density`/`mass`, `friction`, joints (`freejoint` or `type="free"`; other joints
 //! make an `asset.articulated` finding), `<keyframe>`'s first key (`qpos` of free joints).
 //! A body without joints is welded to its parent: under the world it is fixed, under another
-//! body it is merged into that body. A plane on the world body is the floor.
+//! body it is merged into that body; a file whose world holds one such body tree and nothing
+//! else (no joint, no floor: an object model file) is checked as a free object, unless
+//! [`ReadOptions::keep_welded`]. A plane on the world body is the floor.
 
 use crate::error::Result;
 use crate::io::asset::{
@@ -560,6 +562,22 @@ pub fn read(path: &Path, root: &Element, opts: &ReadOptions) -> Result<Asset> {
             geoms,
             inertial,
             merged,
+        });
+    }
+    // An object model file: one welded body tree and nothing else in the world. MuJoCo welds
+    // it, but it is written to be placed into a scene: check it as a free object.
+    let lone = bodies.len() == 1 && bodies[0].fixed && nq == 0 && floor.is_none();
+    if lone && !opts.keep_welded {
+        let b = &mut bodies[0];
+        b.fixed = false;
+        ctx.issues.push(ReadIssue {
+            check: "asset.free_object",
+            subject: b.name.clone(),
+            src: b.src.clone(),
+            message: format!(
+                "body {} has no joint and is alone in the world: checked as a free object resting on a ground plane (MuJoCo alone would weld it; --keep-welded checks it welded)",
+                b.name
+            ),
         });
     }
     Ok(Asset {

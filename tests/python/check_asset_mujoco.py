@@ -1,12 +1,14 @@
 """MuJoCo's own view of an MJCF asset, as JSON on stdout (the judge of tests/assets.rs).
 
-usage: check_asset_mujoco.py MODEL.xml [--seconds S] [--window W]
+usage: check_asset_mujoco.py MODEL.xml [--seconds S] [--window W] [--free-lone-body LIFT]
 
 Reports whether MuJoCo loads the model (and its error if not), the deepest contact between two
 different bodies and between a body and the world's plane after mj_forward (keyframe 0 when the
 model has one), and every free body's centre-of-mass motion (m) and rotation (degrees) over S
 seconds (default 2), and over the last W of them (`window_motion`, default 1): "does it still
-move once it had time to settle".
+move once it had time to settle". --free-lone-body gives the world's first body a free joint,
+lifts it by LIFT and adds a ground plane at z = 0 (an object model file checked as a free
+object, as interact3d validate does).
 """
 import json
 import math
@@ -21,7 +23,16 @@ def main():
     seconds = float(sys.argv[sys.argv.index("--seconds") + 1]) if "--seconds" in sys.argv else 2.0
     window = float(sys.argv[sys.argv.index("--window") + 1]) if "--window" in sys.argv else 1.0
     try:
-        model = mujoco.MjModel.from_xml_path(path)
+        if "--free-lone-body" in sys.argv:
+            lift = float(sys.argv[sys.argv.index("--free-lone-body") + 1])
+            spec = mujoco.MjSpec.from_file(path)
+            body = spec.worldbody.first_body()
+            body.add_freejoint()
+            body.pos = [body.pos[0], body.pos[1], body.pos[2] + lift]
+            spec.worldbody.add_geom(type=mujoco.mjtGeom.mjGEOM_PLANE, size=[2, 2, 0.1])
+            model = spec.compile()
+        else:
+            model = mujoco.MjModel.from_xml_path(path)
     except Exception as e:  # MuJoCo refuses the model: say why
         print(json.dumps({"loads": False, "error": str(e)}))
         return
