@@ -587,3 +587,92 @@ fn cli_outputs_and_exit_codes() {
     let j: serde_json::Value = serde_json::from_str(&o1).unwrap();
     assert!(j["assets"].as_array().unwrap().len() >= 2);
 }
+
+#[test]
+fn frames_replicate_and_mesh_reference_agree_with_mujoco() {
+    let t = tempfile::tempdir().unwrap();
+    write(t.path(), "cube.obj", "v -0.02 -0.01 -0.03\nv 0.02 -0.01 -0.03\nv 0.02 0.01 -0.03\nv -0.02 0.01 -0.03\nv -0.02 -0.01 0.03\nv 0.02 -0.01 0.03\nv 0.02 0.01 0.03\nv -0.02 0.01 0.03\nf 1 3 2\nf 1 4 3\nf 5 6 7\nf 5 7 8\nf 1 2 6\nf 1 6 5\nf 2 3 7\nf 2 7 6\nf 3 4 8\nf 3 8 7\nf 4 1 5\nf 4 5 8\n");
+    let xml = r#"<mujoco>
+  <asset>
+    <mesh name="m" file="cube.obj" scale="1 2 1" refpos="0.01 0 -0.02" refquat="0.9238795 0 0 0.3826834"/>
+  </asset>
+  <worldbody>
+    <geom type="plane" size="1 1 0.1"/>
+    <frame pos="0.1 0 0" euler="0 0 30">
+      <body name="a" pos="0.2 0 0.1">
+        <freejoint/>
+        <frame pos="0 0.05 0" euler="90 0 0">
+          <geom name="ga" type="box" size="0.01 0.02 0.03"/>
+          <geom name="gm" type="mesh" mesh="m" pos="0 0 0.04"/>
+        </frame>
+        <geom name="gc" type="capsule" fromto="0 0 0 0 0.1 0" size="0.01"/>
+      </body>
+    </frame>
+    <replicate count="3" offset="0.1 0 0" euler="0 0 20" sep="-">
+      <body name="r" pos="0 0.3 0.05">
+        <freejoint/>
+        <geom name="gr" type="sphere" size="0.02"/>
+      </body>
+    </replicate>
+  </worldbody>
+</mujoco>
+"#;
+    let p = write(t.path(), "frames.xml", xml);
+    let a = interact3d::io::asset::load(&p, &Default::default()).unwrap();
+    let mj = python_json(
+        "check_asset_mujoco.py",
+        &[p.to_str().unwrap(), "--seconds", "0"],
+    );
+    let geoms = mj["geoms"].as_object().unwrap();
+    assert_eq!(geoms.len(), 6, "{mj}");
+    for (name, g) in geoms {
+        let (b, geom) = a
+            .bodies
+            .iter()
+            .flat_map(|b| b.geoms.iter().map(move |g| (b, g)))
+            .find(|(_, g)| &g.name == name)
+            .unwrap_or_else(|| panic!("geom {name} not read"));
+        let at = |k: usize, v: &serde_json::Value| v[k].as_f64().unwrap();
+        if let Some(bb) = g.get("aabb") {
+            // A mesh: MuJoCo recentres it, so compare where its vertices are in the world.
+            let w: Vec<_> = geom
+                .shape
+                .meshes()
+                .iter()
+                .flat_map(|m| m.vertices.clone())
+                .map(|v| b.pose * geom.pose * v)
+                .collect();
+            let ours = interact3d::mesh::Aabb::of_points(w.iter()).unwrap();
+            for k in 0..3 {
+                assert!(
+                    (ours.min[k] - at(k, &bb[0])).abs() < 1e-6,
+                    "{name} min {ours:?} {bb}"
+                );
+                assert!(
+                    (ours.max[k] - at(k, &bb[1])).abs() < 1e-6,
+                    "{name} max {ours:?} {bb}"
+                );
+            }
+        } else {
+            let c = b.pose * nalgebra::Point3::from(geom.pose.translation.vector);
+            for k in 0..3 {
+                assert!(
+                    (c[k] - at(k, &g["pos"])).abs() < 1e-9,
+                    "{name}: {c} vs {}",
+                    g["pos"]
+                );
+            }
+        }
+    }
+    // What is not read is said, at its line: <attach>, an hfield geom.
+    let p = write(t.path(), "attach.xml", "<mujoco>\n  <asset><hfield name=\"h\" size=\"1 1 0.1 0.1\" nrow=\"2\" ncol=\"2\"/></asset>\n  <worldbody>\n    <body name=\"a\" pos=\"0 0 0.02\">\n      <freejoint/>\n      <geom type=\"sphere\" size=\"0.02\"/>\n      <geom type=\"hfield\" hfield=\"h\"/>\n      <attach model=\"gripper\" body=\"palm\" prefix=\"g_\"/>\n    </body>\n  </worldbody>\n</mujoco>\n");
+    let r = check(&p);
+    let f = find(&r, "file.unsupported");
+    assert_eq!(
+        f.iter().map(|f| f.line).collect::<Vec<_>>(),
+        vec![7, 8],
+        "{:#?}",
+        r.findings
+    );
+    assert!(f[0].message.contains("hfield") && f[1].message.contains("attach"));
+}

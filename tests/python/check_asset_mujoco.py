@@ -48,6 +48,19 @@ def main():
             floor_pen = max(floor_pen, -c.dist)
         elif b1 != b2:
             body_pen = max(body_pen, -c.dist)
+    # Every named geom's world centre, and a mesh geom's world bounding box of its vertices.
+    geoms = {}
+    for g in range(model.ngeom):
+        name = model.geom(g).name
+        if not name:
+            continue
+        info = {"pos": data.geom_xpos[g].tolist()}
+        if model.geom_type[g] == mujoco.mjtGeom.mjGEOM_MESH:
+            m = model.geom_dataid[g]
+            v = model.mesh_vert[model.mesh_vertadr[m]:model.mesh_vertadr[m] + model.mesh_vertnum[m]]
+            w = v @ data.geom_xmat[g].reshape(3, 3).T + data.geom_xpos[g]
+            info["aabb"] = [w.min(axis=0).tolist(), w.max(axis=0).tolist()]
+        geoms[name] = info
     free = [b for b in range(model.nbody) if model.body_jntnum[b] > 0
             and model.jnt_type[model.body_jntadr[b]] == mujoco.mjtJoint.mjJNT_FREE]
     start = {b: (data.xipos[b].copy(), data.xquat[b].copy()) for b in free}
@@ -75,6 +88,7 @@ def main():
         "floor_penetration": floor_pen,
         "motion": motion,
         "window_motion": window_motion,
+        "geoms": geoms,
         "finite": bool(np.all(np.isfinite(data.qpos))),
     }))
 
