@@ -676,3 +676,16 @@ fn frames_replicate_and_mesh_reference_agree_with_mujoco() {
     );
     assert!(f[0].message.contains("hfield") && f[1].message.contains("attach"));
 }
+
+#[test]
+fn xacro_is_one_clear_finding_at_its_line() {
+    let t = tempfile::tempdir().unwrap();
+    let p = write(t.path(), "arm.urdf.xacro", "<?xml version=\"1.0\"?>\n<robot name=\"arm\" xmlns:xacro=\"http://www.ros.org/wiki/xacro\">\n  <xacro:property name=\"r\" value=\"0.05\"/>\n  <link name=\"base\"/>\n</robot>\n");
+    let (code, out, _) = run(&["validate", p.to_str().unwrap(), "--json"]);
+    assert_eq!(code, 2, "nothing readable: {out}");
+    let j: serde_json::Value = serde_json::from_str(&out).unwrap();
+    let f = &j["assets"][0]["findings"][0];
+    assert_eq!(f["check"], "file.parse_error");
+    assert_eq!(f["line"], 2, "{f}");
+    assert!(f["message"].as_str().unwrap().contains("run `xacro"), "{f}");
+}

@@ -219,9 +219,18 @@ pub struct ReadOptions {
     pub keep_welded: bool,
 }
 
-/// Read a URDF or MJCF file.
+/// Read a URDF or MJCF file (a xacro file is an error that says to run xacro first).
 pub fn load(path: &Path, opts: &ReadOptions) -> Result<Asset> {
     let root = crate::io::xml::parse_file(path, &opts.limits)?;
+    if let Some(line) = xacro_line(&root) {
+        return Err(Error::input(
+            path,
+            format!(
+                "line {line}: xacro macros are not expanded here: run `xacro {} > robot.urdf` (ROS xacro) first and validate that URDF",
+                path.display()
+            ),
+        ));
+    }
     match root.name.as_str() {
         "robot" => crate::io::urdf::read(path, &root, opts),
         "mujoco" => crate::io::mjcf::read(path, &root, opts),
@@ -233,6 +242,14 @@ pub fn load(path: &Path, opts: &ReadOptions) -> Result<Asset> {
             ),
         )),
     }
+}
+
+/// The line of the first xacro element or `xmlns:xacro` declaration, if any.
+fn xacro_line(e: &crate::io::xml::Element) -> Option<usize> {
+    if e.name.starts_with("xacro:") || e.attrs.iter().any(|(k, _)| k == "xmlns:xacro") {
+        return Some(e.line);
+    }
+    e.children.iter().find_map(xacro_line)
 }
 
 /// Numbers of an attribute: `n` floats, or an error naming the element's line.

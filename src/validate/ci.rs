@@ -105,7 +105,7 @@ pub fn discover(paths: &[String]) -> Result<Vec<Entry>> {
             let kind = if is_model_file(p)
                 || matches!(
                     p.extension().and_then(|e| e.to_str()),
-                    Some("xml" | "urdf" | "mjcf")
+                    Some("xml" | "urdf" | "mjcf" | "xacro")
                 ) {
                 Kind::Asset
             } else {
