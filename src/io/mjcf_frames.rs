@@ -92,7 +92,7 @@ pub(crate) fn unfold(e: &Element, c: &Compiler, issues: &mut Vec<ReadIssue>) -> 
                 let count = floats(ch, "count")?
                     .and_then(|v| v.first().copied())
                     .ok_or_else(|| ch.error("replicate without count"))?;
-                if !(count >= 1.0 && count <= 10_000.0 && count.fract() == 0.0) {
+                if !((1.0..=10_000.0).contains(&count) && count.fract() == 0.0) {
                     return Err(ch.error(format!("replicate count {count} is not 1..10000")));
                 }
                 let off = floats(ch, "offset")?.unwrap_or(vec![0.0; 3]);
