@@ -205,6 +205,10 @@ struct ValidateArgs {
     /// Skip the settle and rest tests of URDF/MJCF assets (static checks only).
     #[arg(long)]
     no_physics: bool,
+    /// Only the assets whose file, included files or meshes changed since this git revision
+    /// (committed, uncommitted or untracked), e.g. origin/main.
+    #[arg(long, value_name = "GIT_REF")]
+    changed_since: Option<String>,
     /// Check an MJCF object model file (one body, no joint, no floor) welded, as MuJoCo loads
     /// it alone, instead of as a free object on a ground plane.
     #[arg(long)]
@@ -607,8 +611,29 @@ fn run(cli: Cli) -> Result<ExitCode, Error> {
 fn validate(a: ValidateArgs) -> Result<ExitCode, Error> {
     use interact3d::validate::ci;
     let t = std::time::Instant::now();
-    let entries = ci::discover(&a.paths)?;
-    let ci_flags = a.sarif.is_some()
+    let mut entries = ci::discover(&a.paths)?;
+    if let Some(r) = &a.changed_since {
+        let read = interact3d::io::asset::ReadOptions {
+            limits: a.limits.limits(),
+            packages: a.packages.clone(),
+            keep_welded: a.keep_welded,
+        };
+        // The repository of the first path given (or of the working directory).
+        let first = std::path::Path::new(&a.paths[0]);
+        let dir = if first.is_dir() {
+            first.to_path_buf()
+        } else {
+            first
+                .parent()
+                .filter(|p| p.is_dir() && !p.as_os_str().is_empty())
+                .map(|p| p.to_path_buf())
+                .unwrap_or_else(|| PathBuf::from("."))
+        };
+        let changed = ci::changed_files(&dir, r)?;
+        entries = ci::changed_only(entries, &changed, &read);
+    }
+    let ci_flags = a.changed_since.is_some()
+        || a.sarif.is_some()
         || a.github
         || a.baseline.is_some()
         || a.write_baseline.is_some()

@@ -689,3 +689,111 @@ fn xacro_is_one_clear_finding_at_its_line() {
     assert_eq!(f["line"], 2, "{f}");
     assert!(f["message"].as_str().unwrap().contains("run `xacro"), "{f}");
 }
+
+#[test]
+fn changed_since_checks_only_assets_whose_file_or_mesh_changed() {
+    let t = tempfile::tempdir().unwrap();
+    let d = t.path();
+    let git = |args: &[&str]| {
+        let o = std::process::Command::new("git")
+            .arg("-C")
+            .arg(d)
+            .args(args)
+            .output()
+            .expect("git");
+        assert!(
+            o.status.success(),
+            "git {args:?}: {}",
+            String::from_utf8_lossy(&o.stderr)
+        );
+    };
+    let cube = |s: f64| {
+        let v: String = [
+            (-1, -1, -1),
+            (1, -1, -1),
+            (1, 1, -1),
+            (-1, 1, -1),
+            (-1, -1, 1),
+            (1, -1, 1),
+            (1, 1, 1),
+            (-1, 1, 1),
+        ]
+        .iter()
+        .map(|(x, y, z)| format!("v {} {} {}\n", *x as f64 * s, *y as f64 * s, *z as f64 * s))
+        .collect();
+        v + "f 1 3 2\nf 1 4 3\nf 5 6 7\nf 5 7 8\nf 1 2 6\nf 1 6 5\nf 2 3 7\nf 2 7 6\nf 3 4 8\nf 3 8 7\nf 4 1 5\nf 4 5 8\n"
+    };
+    for n in ["a", "b", "c"] {
+        write(d, &format!("{n}.obj"), &cube(0.03));
+        write(
+            d,
+            &format!("{n}.urdf"),
+            &urdf(
+                &inertial(0.2, box_inertia(0.2, [0.06; 3]), [0.0; 3]),
+                &format!("<mesh filename=\"{n}.obj\"/>"),
+                &format!("<mesh filename=\"{n}.obj\"/>"),
+            ),
+        );
+    }
+    git(&["init", "-q"]);
+    git(&["add", "."]);
+    git(&[
+        "-c",
+        "user.name=t",
+        "-c",
+        "user.email=t@t",
+        "commit",
+        "-qm",
+        "assets",
+    ]);
+    // b's mesh changes (uncommitted), c's URDF is untouched, d is new and untracked.
+    write(d, "b.obj", &cube(0.031));
+    write(
+        d,
+        "d.urdf",
+        &std::fs::read_to_string(d.join("a.urdf")).unwrap(),
+    );
+    let dir = d.to_str().unwrap();
+    let (code, out, err) = run(&[
+        "validate",
+        dir,
+        "--changed-since",
+        "HEAD",
+        "--json",
+        "--no-physics",
+    ]);
+    assert_eq!(code, 0, "{err}");
+    let j: serde_json::Value = serde_json::from_str(&out).unwrap();
+    let files: Vec<String> = j["assets"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|a| {
+            Path::new(a["file"].as_str().unwrap())
+                .file_name()
+                .unwrap()
+                .to_string_lossy()
+                .into_owned()
+        })
+        .collect();
+    assert_eq!(files, vec!["b.urdf", "d.urdf"], "{err}");
+    // Nothing changed since the working tree: nothing to check, exit 0; a bad revision: 2.
+    git(&["add", "."]);
+    git(&[
+        "-c",
+        "user.name=t",
+        "-c",
+        "user.email=t@t",
+        "commit",
+        "-qm",
+        "more",
+    ]);
+    let (code, out, _) = run(&["validate", dir, "--changed-since", "HEAD", "--json"]);
+    assert_eq!(code, 0);
+    let j: serde_json::Value = serde_json::from_str(&out).unwrap();
+    assert_eq!(j["assets"].as_array().unwrap().len(), 0);
+    assert_eq!(
+        run(&["validate", dir, "--changed-since", "no-such-ref"]).0,
+        2
+    );
+}
