@@ -618,19 +618,7 @@ fn validate(a: ValidateArgs) -> Result<ExitCode, Error> {
             packages: a.packages.clone(),
             keep_welded: a.keep_welded,
         };
-        // The repository of the first path given (or of the working directory).
-        let first = std::path::Path::new(&a.paths[0]);
-        let dir = if first.is_dir() {
-            first.to_path_buf()
-        } else {
-            first
-                .parent()
-                .filter(|p| p.is_dir() && !p.as_os_str().is_empty())
-                .map(|p| p.to_path_buf())
-                .unwrap_or_else(|| PathBuf::from("."))
-        };
-        let changed = ci::changed_files(&dir, r)?;
-        entries = ci::changed_only(entries, &changed, &read);
+        entries = ci::changed_since(entries, &a.paths[0], r, &read)?;
     }
     let ci_flags = a.changed_since.is_some()
         || a.sarif.is_some()

@@ -1,7 +1,7 @@
 //! Many assets at once, for CI: discovery of files, folders and globs, the parallel run, and
 //! the outputs (table, JSON, SARIF 2.1.0, GitHub annotations, JUnit, baselines).
 //!
-//! Entry points: [`discover`], [`changed_only`] (`--changed-since REF`), [`run`]
+//! Entry points: [`discover`], [`changed_since`] (`--changed-since REF`), [`run`]
 //! ([`RunOptions`] → [`Run`]), [`table`], [`json`],
 //! [`sarif`], [`github`], [`junit`], [`read_baseline`], [`baseline_json`], [`exit_code`].
 
@@ -644,4 +644,25 @@ pub fn changed_only(
                 .any(|f| changed.contains(&abs(f))),
         })
         .collect()
+}
+
+/// `--changed-since`: the entries that read a file changed since `git_ref` in the repository of
+/// `first` (the first path given: a folder, or a file's folder; else the working directory).
+pub fn changed_since(
+    entries: Vec<Entry>,
+    first: &str,
+    git_ref: &str,
+    read: &crate::io::asset::ReadOptions,
+) -> Result<Vec<Entry>> {
+    let first = Path::new(first);
+    let dir = if first.is_dir() {
+        first.to_path_buf()
+    } else {
+        first
+            .parent()
+            .filter(|p| p.is_dir() && !p.as_os_str().is_empty())
+            .map(Path::to_path_buf)
+            .unwrap_or_else(|| PathBuf::from("."))
+    };
+    Ok(changed_only(entries, &changed_files(&dir, git_ref)?, read))
 }
