@@ -8,7 +8,10 @@
 //! (found through `python3 -c "import pybullet_data"`), every YCB URDF and every Google Scanned
 //! Objects model.xml under ../shared/datasets/objects, cycled to N. Each asset is timed alone
 //! on one thread (all checks, physics included), then the N together in parallel. simcheck
-//! (`simcheck check FILE`, its defaults) runs once on each distinct file, one at a time.
+//! (`simcheck check --no-cache FILE`, its engines MuJoCo and PyBullet: pip `simcheck`, pinned
+//! in tests/python/requirements-bench.txt) runs on the same N assets, one at a time (its cache
+//! off, so a repeated file costs what it costs the first time); `--simcheck-n K` stops it after
+//! the first K. A second table gives each distinct file's mean and worst for both tools.
 
 use interact3d::validate::asset::{check_path, AssetCheckOptions};
 use interact3d::validate::ci::{run, Entry, Kind, RunOptions};
@@ -73,6 +76,7 @@ fn main() {
         }
     }
     let opts = AssetCheckOptions::default();
+    let mut per_file: std::collections::BTreeMap<usize, (Vec<f64>, Vec<f64>)> = Default::default();
     let mut times = Vec::new();
     let mut findings = 0;
     for k in 0..n {
@@ -84,6 +88,11 @@ fn main() {
             .unwrap()
             .install(|| check_path(f, &f.display().to_string(), &opts));
         times.push(t.elapsed().as_secs_f64());
+        per_file
+            .entry(k % files.len())
+            .or_default()
+            .0
+            .push(t.elapsed().as_secs_f64());
         findings += r.findings.len();
     }
     let entries: Vec<Entry> = (0..n)
@@ -116,23 +125,48 @@ fn main() {
     if let Some(bin) = simcheck {
         let mut st = Vec::new();
         let mut codes = std::collections::BTreeMap::new();
-        for f in files.iter().take(simcheck_n) {
+        for k in 0..n.min(simcheck_n) {
+            let f = &files[k % files.len()];
             let t = Instant::now();
             let o = std::process::Command::new(&bin)
-                .arg("check")
+                .args(["check", "--no-cache"])
                 .arg(f)
                 .output()
                 .expect("simcheck");
             st.push(t.elapsed().as_secs_f64());
+            per_file
+                .entry(k % files.len())
+                .or_default()
+                .1
+                .push(t.elapsed().as_secs_f64());
             *codes.entry(o.status.code().unwrap_or(-1)).or_insert(0) += 1;
         }
         let (m, w) = stats(&st);
         println!(
-            "| simcheck check | {} | {} | {m:.3} | {w:.3} | {:.2} (sequential) |",
+            "| simcheck check --no-cache | {} | {} | {m:.3} | {w:.3} | {:.2} (sequential) |",
             st.len(),
-            st.len(),
+            files.len().min(st.len()),
             st.iter().sum::<f64>()
         );
         eprintln!("simcheck exit codes: {codes:?}");
+    }
+    println!();
+    println!("| file | runs | ours mean s | ours worst s | simcheck mean s | simcheck worst s |");
+    println!("|---|---|---|---|---|---|");
+    for (k, (ours, theirs)) in &per_file {
+        let (om, ow) = stats(ours);
+        let name = files[*k]
+            .strip_prefix(&objects)
+            .or_else(|_| files[*k].strip_prefix(&pb))
+            .unwrap_or(&files[*k])
+            .display()
+            .to_string();
+        let sc = if theirs.is_empty() {
+            "| – | – |".to_string()
+        } else {
+            let (sm, sw) = stats(theirs);
+            format!("| {sm:.2} | {sw:.2} |")
+        };
+        println!("| {name} | {} | {om:.3} | {ow:.3} {sc}", ours.len());
     }
 }

@@ -209,6 +209,14 @@ struct ValidateArgs {
     /// Skip the settle and rest tests of URDF/MJCF assets (static checks only).
     #[arg(long)]
     no_physics: bool,
+    /// Only the assets whose file, included files or meshes changed since this git revision
+    /// (committed, uncommitted or untracked), e.g. origin/main.
+    #[arg(long, value_name = "GIT_REF")]
+    changed_since: Option<String>,
+    /// Check an MJCF object model file (one body, no joint, no floor) welded, as MuJoCo loads
+    /// it alone, instead of as a free object on a ground plane.
+    #[arg(long)]
+    keep_welded: bool,
     #[command(flatten)]
     build: BuildArgs,
     #[command(flatten)]
@@ -618,8 +626,17 @@ fn run(cli: Cli) -> Result<ExitCode, Error> {
 fn validate(a: ValidateArgs) -> Result<ExitCode, Error> {
     use interact3d::validate::ci;
     let t = std::time::Instant::now();
-    let entries = ci::discover(&a.paths)?;
-    let ci_flags = a.sarif.is_some()
+    let mut entries = ci::discover(&a.paths)?;
+    if let Some(r) = &a.changed_since {
+        let read = interact3d::io::asset::ReadOptions {
+            limits: a.limits.limits(),
+            packages: a.packages.clone(),
+            keep_welded: a.keep_welded,
+        };
+        entries = ci::changed_since(entries, &a.paths[0], r, &read)?;
+    }
+    let ci_flags = a.changed_since.is_some()
+        || a.sarif.is_some()
         || a.github
         || a.baseline.is_some()
         || a.write_baseline.is_some()
@@ -680,6 +697,7 @@ fn validate(a: ValidateArgs) -> Result<ExitCode, Error> {
     };
     opts.asset.read.limits = a.limits.limits();
     opts.asset.read.packages = a.packages.clone();
+    opts.asset.read.keep_welded = a.keep_welded;
     opts.asset.physics = !a.no_physics;
     opts.asset.settle = interact3d::physics::SettleOptions {
         perturbation_speed: opts.asset.settle.perturbation_speed,

@@ -3,80 +3,13 @@
 //! verdict on the MJCF cases, our own exports read back, and the CI outputs.
 //! Needs Python with `pybullet` (for pybullet_data) and `mujoco` (tests/python/requirements.txt).
 
+#[path = "asset_cases/mod.rs"]
+mod cases;
 mod common;
+use cases::*;
 use common::*;
 use interact3d::validate::asset::{check_path, AssetCheckOptions};
-use interact3d::validate::finding::{AssetReport, Finding};
-use std::path::{Path, PathBuf};
-
-fn pybullet_data() -> PathBuf {
-    let out = std::process::Command::new(python())
-        .args([
-            "-c",
-            "import pybullet_data;print(pybullet_data.getDataPath())",
-        ])
-        .output()
-        .expect("python3 with pybullet (tests/python/requirements.txt)");
-    assert!(out.status.success(), "pybullet_data not installed");
-    PathBuf::from(String::from_utf8_lossy(&out.stdout).trim())
-}
-
-fn check(p: &Path) -> AssetReport {
-    check_path(p, p.to_str().unwrap(), &AssetCheckOptions::default())
-}
-
-fn find<'a>(r: &'a AssetReport, id: &str) -> Vec<&'a Finding> {
-    r.findings.iter().filter(|f| f.check == id).collect()
-}
-
-fn ids(r: &AssetReport) -> Vec<&str> {
-    r.findings.iter().map(|f| f.check.as_str()).collect()
-}
-
-fn apple() -> String {
-    shared()
-        .join("datasets/objects/ycb/013_apple/textured.obj")
-        .canonicalize()
-        .unwrap()
-        .display()
-        .to_string()
-}
-
-fn mug() -> PathBuf {
-    shared()
-        .join("datasets/objects/gso/ACE_Coffee_Mug_Kristen_16_oz_cup/model.obj")
-        .canonicalize()
-        .unwrap()
-}
-
-fn write(dir: &Path, name: &str, text: &str) -> PathBuf {
-    let p = dir.join(name);
-    std::fs::write(&p, text).unwrap();
-    p
-}
-
-/// A one-link URDF: `inertial` and `geometry` blocks as given.
-fn urdf(inertial: &str, visual: &str, collision: &str) -> String {
-    format!(
-        "<?xml version=\"1.0\"?>\n<robot name=\"t\">\n  <link name=\"obj\">\n{inertial}\n    <visual><geometry>{visual}</geometry></visual>\n    <collision><geometry>{collision}</geometry></collision>\n  </link>\n</robot>\n"
-    )
-}
-
-fn inertial(mass: f64, i: [f64; 3], com: [f64; 3]) -> String {
-    format!(
-        "    <inertial>\n      <origin xyz=\"{} {} {}\"/>\n      <mass value=\"{mass}\"/>\n      <inertia ixx=\"{}\" iyy=\"{}\" izz=\"{}\" ixy=\"0\" ixz=\"0\" iyz=\"0\"/>\n    </inertial>",
-        com[0], com[1], com[2], i[0], i[1], i[2]
-    )
-}
-
-/// Exact inertia of a solid box of mass `m` and full extents `e` about its centre.
-fn box_inertia(m: f64, e: [f64; 3]) -> [f64; 3] {
-    [
-        m * (e[1] * e[1] + e[2] * e[2]) / 12.0,
-        m * (e[0] * e[0] + e[2] * e[2]) / 12.0,
-        m * (e[0] * e[0] + e[1] * e[1]) / 12.0,
-    ]
-}
+use std::path::Path;
 
 #[test]
 fn pybullet_data_real_files() {
@@ -92,10 +25,14 @@ fn pybullet_data_real_files() {
             10.min(p[0].line.max(8)),
             "{f}: line of <inertial>"
         );
+        // Errors: only the duck's settle. Its mesh is Y-up and the URDF does not turn it, so it
+        // lies on its side; with the inertia its shape implies it rolls over by 90° (so does
+        // PyBullet with the same moments: tests/asset_judges.rs).
         assert!(
-            r.findings
-                .iter()
-                .all(|f| f.severity < interact3d::validate::finding::Severity::Error),
+            r.findings.iter().all(
+                |x| x.severity < interact3d::validate::finding::Severity::Error
+                    || (f == "duck_vhacd.urdf" && x.check == "physics.settle")
+            ),
             "{f}: {:#?}",
             r.findings
         );
@@ -291,49 +228,6 @@ fn geometry_checks() {
     );
 }
 
-/// The mug (a concave collision mesh, welded) and a 1 cm ball placed in its cavity or beside it.
-fn mug_scene(dir: &Path, name: &str, inside: bool) -> PathBuf {
-    let m = interact3d::io::load_visual(&mug(), &Default::default())
-        .unwrap()
-        .geometry();
-    let b = m.aabb().unwrap();
-    let top: Vec<_> = m
-        .vertices
-        .iter()
-        .filter(|v| v.z > b.max.z - 0.004)
-        .collect();
-    let cx = top.iter().map(|v| v.x).sum::<f64>() / top.len() as f64;
-    let cy = top.iter().map(|v| v.y).sum::<f64>() / top.len() as f64;
-    let (x, y, z) = if inside {
-        (cx, cy, b.min.z + 0.5 * (b.max.z - b.min.z))
-    } else {
-        (b.max.x + 0.05, cy, b.min.z + 0.0101)
-    };
-    let xml = format!(
-        r#"<mujoco model="{name}">
-  <compiler angle="radian"/>
-  <asset>
-    <mesh name="mug" file="{}"/>
-  </asset>
-  <worldbody>
-    <geom name="floor" type="plane" size="1 1 0.1" pos="0 0 {}"/>
-    <body name="mug">
-      <geom name="mug_collision" type="mesh" mesh="mug"/>
-    </body>
-    <body name="ball" pos="{x} {y} {z}">
-      <freejoint/>
-      <inertial pos="0 0 0" mass="0.01" diaginertia="4e-7 4e-7 4e-7"/>
-      <geom name="ball_collision" type="sphere" size="0.01"/>
-    </body>
-  </worldbody>
-</mujoco>
-"#,
-        mug().display(),
-        b.min.z
-    );
-    write(dir, &format!("{name}.xml"), &xml)
-}
-
 #[test]
 fn concave_hull_with_a_body_inside_and_mujoco_agrees() {
     let t = tempfile::tempdir().unwrap();
@@ -390,36 +284,6 @@ fn concave_hull_with_a_body_inside_and_mujoco_agrees() {
         mj["motion"]["ball"]["moved"].as_f64().unwrap() < 1e-3,
         "{mj}"
     );
-}
-
-/// Two boxes (MJCF) `gap` apart along x (negative: overlapping), the lower `sink` below the floor.
-fn boxes(dir: &Path, name: &str, gap: f64, sink: f64, tilt_deg: f64) -> PathBuf {
-    let h = 0.025;
-    let xml = format!(
-        r#"<mujoco model="{name}">
-  <worldbody>
-    <geom name="floor" type="plane" size="1 1 0.1"/>
-    <body name="a" pos="0 0 {}">
-      <freejoint/>
-      <geom type="box" size="{h} {h} {h}" density="500"/>
-    </body>
-    <body name="b" pos="{} 0 {}" euler="0 {tilt_deg} 0">
-      <freejoint/>
-      <geom type="box" size="0.01 0.01 0.1" density="500"/>
-    </body>
-  </worldbody>
-</mujoco>
-"#,
-        h - sink,
-        2.0 * h + gap + 0.3,
-        if tilt_deg == 0.0 {
-            0.1
-        } else {
-            0.1 * tilt_deg.to_radians().cos() + 0.01 * tilt_deg.to_radians().sin()
-        }
-    );
-    let _ = 2.0 * h;
-    write(dir, &format!("{name}.xml"), &xml)
 }
 
 #[test]
@@ -722,4 +586,214 @@ fn cli_outputs_and_exit_codes() {
     assert_eq!((c1, &o1), (c2, &o2));
     let j: serde_json::Value = serde_json::from_str(&o1).unwrap();
     assert!(j["assets"].as_array().unwrap().len() >= 2);
+}
+
+#[test]
+fn frames_replicate_and_mesh_reference_agree_with_mujoco() {
+    let t = tempfile::tempdir().unwrap();
+    write(t.path(), "cube.obj", "v -0.02 -0.01 -0.03\nv 0.02 -0.01 -0.03\nv 0.02 0.01 -0.03\nv -0.02 0.01 -0.03\nv -0.02 -0.01 0.03\nv 0.02 -0.01 0.03\nv 0.02 0.01 0.03\nv -0.02 0.01 0.03\nf 1 3 2\nf 1 4 3\nf 5 6 7\nf 5 7 8\nf 1 2 6\nf 1 6 5\nf 2 3 7\nf 2 7 6\nf 3 4 8\nf 3 8 7\nf 4 1 5\nf 4 5 8\n");
+    let xml = r#"<mujoco>
+  <asset>
+    <mesh name="m" file="cube.obj" scale="1 2 1" refpos="0.01 0 -0.02" refquat="0.9238795 0 0 0.3826834"/>
+  </asset>
+  <worldbody>
+    <geom type="plane" size="1 1 0.1"/>
+    <frame pos="0.1 0 0" euler="0 0 30">
+      <body name="a" pos="0.2 0 0.1">
+        <freejoint/>
+        <frame pos="0 0.05 0" euler="90 0 0">
+          <geom name="ga" type="box" size="0.01 0.02 0.03"/>
+          <geom name="gm" type="mesh" mesh="m" pos="0 0 0.04"/>
+        </frame>
+        <geom name="gc" type="capsule" fromto="0 0 0 0 0.1 0" size="0.01"/>
+      </body>
+    </frame>
+    <replicate count="3" offset="0.1 0 0" euler="0 0 20" sep="-">
+      <body name="r" pos="0 0.3 0.05">
+        <freejoint/>
+        <geom name="gr" type="sphere" size="0.02"/>
+      </body>
+    </replicate>
+  </worldbody>
+</mujoco>
+"#;
+    let p = write(t.path(), "frames.xml", xml);
+    let a = interact3d::io::asset::load(&p, &Default::default()).unwrap();
+    let mj = python_json(
+        "check_asset_mujoco.py",
+        &[p.to_str().unwrap(), "--seconds", "0"],
+    );
+    let geoms = mj["geoms"].as_object().unwrap();
+    assert_eq!(geoms.len(), 6, "{mj}");
+    for (name, g) in geoms {
+        let (b, geom) = a
+            .bodies
+            .iter()
+            .flat_map(|b| b.geoms.iter().map(move |g| (b, g)))
+            .find(|(_, g)| &g.name == name)
+            .unwrap_or_else(|| panic!("geom {name} not read"));
+        let at = |k: usize, v: &serde_json::Value| v[k].as_f64().unwrap();
+        if let Some(bb) = g.get("aabb") {
+            // A mesh: MuJoCo recentres it, so compare where its vertices are in the world.
+            let w: Vec<_> = geom
+                .shape
+                .meshes()
+                .iter()
+                .flat_map(|m| m.vertices.clone())
+                .map(|v| b.pose * geom.pose * v)
+                .collect();
+            let ours = interact3d::mesh::Aabb::of_points(w.iter()).unwrap();
+            for k in 0..3 {
+                assert!(
+                    (ours.min[k] - at(k, &bb[0])).abs() < 1e-6,
+                    "{name} min {ours:?} {bb}"
+                );
+                assert!(
+                    (ours.max[k] - at(k, &bb[1])).abs() < 1e-6,
+                    "{name} max {ours:?} {bb}"
+                );
+            }
+        } else {
+            let c = b.pose * nalgebra::Point3::from(geom.pose.translation.vector);
+            for k in 0..3 {
+                assert!(
+                    (c[k] - at(k, &g["pos"])).abs() < 1e-9,
+                    "{name}: {c} vs {}",
+                    g["pos"]
+                );
+            }
+        }
+    }
+    // What is not read is said, at its line: <attach>, an hfield geom.
+    let p = write(t.path(), "attach.xml", "<mujoco>\n  <asset><hfield name=\"h\" size=\"1 1 0.1 0.1\" nrow=\"2\" ncol=\"2\"/></asset>\n  <worldbody>\n    <body name=\"a\" pos=\"0 0 0.02\">\n      <freejoint/>\n      <geom type=\"sphere\" size=\"0.02\"/>\n      <geom type=\"hfield\" hfield=\"h\"/>\n      <attach model=\"gripper\" body=\"palm\" prefix=\"g_\"/>\n    </body>\n  </worldbody>\n</mujoco>\n");
+    let r = check(&p);
+    let f = find(&r, "file.unsupported");
+    assert_eq!(
+        f.iter().map(|f| f.line).collect::<Vec<_>>(),
+        vec![7, 8],
+        "{:#?}",
+        r.findings
+    );
+    assert!(f[0].message.contains("hfield") && f[1].message.contains("attach"));
+}
+
+#[test]
+fn xacro_is_one_clear_finding_at_its_line() {
+    let t = tempfile::tempdir().unwrap();
+    let p = write(t.path(), "arm.urdf.xacro", "<?xml version=\"1.0\"?>\n<robot name=\"arm\" xmlns:xacro=\"http://www.ros.org/wiki/xacro\">\n  <xacro:property name=\"r\" value=\"0.05\"/>\n  <link name=\"base\"/>\n</robot>\n");
+    let (code, out, _) = run(&["validate", p.to_str().unwrap(), "--json"]);
+    assert_eq!(code, 2, "nothing readable: {out}");
+    let j: serde_json::Value = serde_json::from_str(&out).unwrap();
+    let f = &j["assets"][0]["findings"][0];
+    assert_eq!(f["check"], "file.parse_error");
+    assert_eq!(f["line"], 2, "{f}");
+    assert!(f["message"].as_str().unwrap().contains("run `xacro"), "{f}");
+}
+
+#[test]
+fn changed_since_checks_only_assets_whose_file_or_mesh_changed() {
+    let t = tempfile::tempdir().unwrap();
+    let d = t.path();
+    let git = |args: &[&str]| {
+        let o = std::process::Command::new("git")
+            .arg("-C")
+            .arg(d)
+            .args(args)
+            .output()
+            .expect("git");
+        assert!(
+            o.status.success(),
+            "git {args:?}: {}",
+            String::from_utf8_lossy(&o.stderr)
+        );
+    };
+    let cube = |s: f64| {
+        let v: String = [
+            (-1, -1, -1),
+            (1, -1, -1),
+            (1, 1, -1),
+            (-1, 1, -1),
+            (-1, -1, 1),
+            (1, -1, 1),
+            (1, 1, 1),
+            (-1, 1, 1),
+        ]
+        .iter()
+        .map(|(x, y, z)| format!("v {} {} {}\n", *x as f64 * s, *y as f64 * s, *z as f64 * s))
+        .collect();
+        v + "f 1 3 2\nf 1 4 3\nf 5 6 7\nf 5 7 8\nf 1 2 6\nf 1 6 5\nf 2 3 7\nf 2 7 6\nf 3 4 8\nf 3 8 7\nf 4 1 5\nf 4 5 8\n"
+    };
+    for n in ["a", "b", "c"] {
+        write(d, &format!("{n}.obj"), &cube(0.03));
+        write(
+            d,
+            &format!("{n}.urdf"),
+            &urdf(
+                &inertial(0.2, box_inertia(0.2, [0.06; 3]), [0.0; 3]),
+                &format!("<mesh filename=\"{n}.obj\"/>"),
+                &format!("<mesh filename=\"{n}.obj\"/>"),
+            ),
+        );
+    }
+    git(&["init", "-q"]);
+    git(&["add", "."]);
+    git(&[
+        "-c",
+        "user.name=t",
+        "-c",
+        "user.email=t@t",
+        "commit",
+        "-qm",
+        "assets",
+    ]);
+    // b's mesh changes (uncommitted), c's URDF is untouched, d is new and untracked.
+    write(d, "b.obj", &cube(0.031));
+    write(
+        d,
+        "d.urdf",
+        &std::fs::read_to_string(d.join("a.urdf")).unwrap(),
+    );
+    let dir = d.to_str().unwrap();
+    let (code, out, err) = run(&[
+        "validate",
+        dir,
+        "--changed-since",
+        "HEAD",
+        "--json",
+        "--no-physics",
+    ]);
+    assert_eq!(code, 0, "{err}");
+    let j: serde_json::Value = serde_json::from_str(&out).unwrap();
+    let files: Vec<String> = j["assets"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|a| {
+            Path::new(a["file"].as_str().unwrap())
+                .file_name()
+                .unwrap()
+                .to_string_lossy()
+                .into_owned()
+        })
+        .collect();
+    assert_eq!(files, vec!["b.urdf", "d.urdf"], "{err}");
+    // Nothing changed since the working tree: nothing to check, exit 0; a bad revision: 2.
+    git(&["add", "."]);
+    git(&[
+        "-c",
+        "user.name=t",
+        "-c",
+        "user.email=t@t",
+        "commit",
+        "-qm",
+        "more",
+    ]);
+    let (code, out, _) = run(&["validate", dir, "--changed-since", "HEAD", "--json"]);
+    assert_eq!(code, 0);
+    let j: serde_json::Value = serde_json::from_str(&out).unwrap();
+    assert_eq!(j["assets"].as_array().unwrap().len(), 0);
+    assert_eq!(
+        run(&["validate", dir, "--changed-since", "no-such-ref"]).0,
+        2
+    );
 }

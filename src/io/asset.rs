@@ -213,11 +213,24 @@ pub struct ReadOptions {
     pub limits: Limits,
     /// `package://NAME/...` → `DIR/...` (URDF).
     pub packages: Vec<(String, PathBuf)>,
+    /// MJCF: keep a lone welded body welded. By default an object model file (no joint at all,
+    /// no floor, nothing on the world body but one body tree, as Google Scanned Objects and
+    /// robosuite object files are written) is checked as the free object it is meant to be.
+    pub keep_welded: bool,
 }
 
-/// Read a URDF or MJCF file.
+/// Read a URDF or MJCF file (a xacro file is an error that says to run xacro first).
 pub fn load(path: &Path, opts: &ReadOptions) -> Result<Asset> {
     let root = crate::io::xml::parse_file(path, &opts.limits)?;
+    if let Some(line) = xacro_line(&root) {
+        return Err(Error::input(
+            path,
+            format!(
+                "line {line}: xacro macros are not expanded here: run `xacro {} > robot.urdf` (ROS xacro) first and validate that URDF",
+                path.display()
+            ),
+        ));
+    }
     match root.name.as_str() {
         "robot" => crate::io::urdf::read(path, &root, opts),
         "mujoco" => crate::io::mjcf::read(path, &root, opts),
@@ -229,6 +242,14 @@ pub fn load(path: &Path, opts: &ReadOptions) -> Result<Asset> {
             ),
         )),
     }
+}
+
+/// The line of the first xacro element or `xmlns:xacro` declaration, if any.
+fn xacro_line(e: &crate::io::xml::Element) -> Option<usize> {
+    if e.name.starts_with("xacro:") || e.attrs.iter().any(|(k, _)| k == "xmlns:xacro") {
+        return Some(e.line);
+    }
+    e.children.iter().find_map(xacro_line)
 }
 
 /// Numbers of an attribute: `n` floats, or an error naming the element's line.

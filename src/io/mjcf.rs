@@ -3,7 +3,9 @@
 //!
 //! Entry point: [`read`] (called by [`crate::io::asset::load`]).
 //!
-//! Read: `<include>` (recursively, relative to the main file), `<default>` classes with
+//! Read: `<include>` (recursively, relative to the main file), `<frame>` and `<replicate>`
+//! ([`crate::io::mjcf_frames`]; `<attach>` is a `file.unsupported` finding), mesh `refpos`/
+//! `refquat`, `<default>` classes with
 //! `class` and `childclass`, `<compiler angle meshdir assetdir eulerseq>` (angles in degrees
 //! unless `angle="radian"`), mesh assets (`file`, `scale`, inline `vertex`; OBJ, STL, glTF and
 //! legacy `.msh`), bodies (`pos`, `quat`, `euler`, `axisangle`, `xyaxes`, `zaxis`), `<inertial>`
@@ -12,7 +14,9 @@
 //! ≥ 3 hidden), `density`/`mass`, `friction`, joints (`freejoint` or `type="free"`; other joints
 //! make an `asset.articulated` finding), `<keyframe>`'s first key (`qpos` of free joints).
 //! A body without joints is welded to its parent: under the world it is fixed, under another
-//! body it is merged into that body. A plane on the world body is the floor.
+//! body it is merged into that body; a file whose world holds one such body tree and nothing
+//! else (no joint, no floor: an object model file) is checked as a free object, unless
+//! [`ReadOptions::keep_welded`]. A plane on the world body is the floor.
 
 use crate::error::Result;
 use crate::io::asset::{
@@ -51,7 +55,7 @@ fn expand(e: &Element, base: &Path, opts: &ReadOptions, depth: usize) -> Result<
     Ok(out)
 }
 
-struct Compiler {
+pub(crate) struct Compiler {
     degrees: bool,
     eulerseq: String,
     meshdir: PathBuf,
@@ -179,7 +183,7 @@ fn orientation(e: &Element, c: &Compiler) -> Result<UnitQuaternion<f64>> {
     Ok(UnitQuaternion::identity())
 }
 
-fn frame(e: &Element, c: &Compiler) -> Result<Isometry3<f64>> {
+pub(crate) fn frame(e: &Element, c: &Compiler) -> Result<Isometry3<f64>> {
     let p = match floats(e, "pos")? {
         Some(p) if p.len() == 3 => p,
         Some(_) => return Err(e.error("pos needs 3 numbers")),
@@ -196,6 +200,9 @@ struct MeshAsset {
     file: Option<PathBuf>,
     scale: V3,
     vertex: Option<Vec<f64>>,
+    /// `refpos`/`refquat`: the frame the vertices are written in (MuJoCo subtracts refpos
+    /// and turns by the conjugate of refquat, in the file's units, before `scale`).
+    reference: Isometry3<f64>,
 }
 
 struct Ctx<'a> {
@@ -332,6 +339,26 @@ impl Ctx<'_> {
                     }
                 }
             };
+            // MuJoCo moves the file's vertices into the reference frame, then scales them.
+            let back = a.reference.inverse();
+            let s = a.scale;
+            let got = got.map(|pieces| {
+                if a.reference == Isometry3::identity() || s.iter().any(|x| *x == 0.0) {
+                    return pieces;
+                }
+                pieces
+                    .into_iter()
+                    .map(|m| {
+                        let v = m
+                            .vertices
+                            .iter()
+                            .map(|v| back * P3::from(v.coords.component_div(&s)))
+                            .map(|v| P3::from(v.coords.component_mul(&s)))
+                            .collect();
+                        crate::mesh::Mesh::new(v, m.triangles)
+                    })
+                    .collect::<Vec<_>>()
+            });
             self.cache.insert(key.clone(), got);
         }
         let file = a.file.clone().unwrap_or_default();
@@ -385,6 +412,8 @@ pub fn read(path: &Path, root: &Element, opts: &ReadOptions) -> Result<Asset> {
             c.meshdir = base.join(d);
         }
     }
+    let mut early_issues = Vec::new();
+    let root = crate::io::mjcf_frames::unfold(&root, &c, &mut early_issues)?;
     let mut defaults = Defaults::new();
     for d in root.children_named("default") {
         collect_defaults(d, None, &mut defaults);
@@ -408,6 +437,18 @@ pub fn read(path: &Path, root: &Element, opts: &ReadOptions) -> Result<Asset> {
                 return Err(m.error("scale needs 3 numbers"));
             }
             let vertex = floats(&m, "vertex")?;
+            let refpos = match floats(&m, "refpos")? {
+                Some(p) if p.len() == 3 => V3::new(p[0], p[1], p[2]),
+                Some(_) => return Err(m.error("refpos needs 3 numbers")),
+                None => V3::zeros(),
+            };
+            let refquat = match floats(&m, "refquat")? {
+                Some(q) if q.len() == 4 && q.iter().any(|x| *x != 0.0) => {
+                    UnitQuaternion::new_normalize(Quaternion::new(q[0], q[1], q[2], q[3]))
+                }
+                Some(_) => return Err(m.error("refquat needs 4 numbers, not all zero")),
+                None => UnitQuaternion::identity(),
+            };
             meshes.insert(
                 name,
                 MeshAsset {
@@ -415,6 +456,7 @@ pub fn read(path: &Path, root: &Element, opts: &ReadOptions) -> Result<Asset> {
                     file,
                     scale: V3::new(s[0], s[1], s[2]),
                     vertex,
+                    reference: Isometry3::from_parts(Translation3::from(refpos), refquat),
                 },
             );
         }
@@ -424,7 +466,7 @@ pub fn read(path: &Path, root: &Element, opts: &ReadOptions) -> Result<Asset> {
         defaults,
         meshes,
         opts,
-        issues: Vec::new(),
+        issues: early_issues,
         cache: BTreeMap::new(),
     };
     let mut flats: Vec<Flat> = Vec::new();
@@ -560,6 +602,22 @@ pub fn read(path: &Path, root: &Element, opts: &ReadOptions) -> Result<Asset> {
             geoms,
             inertial,
             merged,
+        });
+    }
+    // An object model file: one welded body tree and nothing else in the world. MuJoCo welds
+    // it, but it is written to be placed into a scene: check it as a free object.
+    let lone = bodies.len() == 1 && bodies[0].fixed && nq == 0 && floor.is_none();
+    if lone && !opts.keep_welded {
+        let b = &mut bodies[0];
+        b.fixed = false;
+        ctx.issues.push(ReadIssue {
+            check: "asset.free_object",
+            subject: b.name.clone(),
+            src: b.src.clone(),
+            message: format!(
+                "body {} has no joint and is alone in the world: checked as a free object resting on a ground plane (MuJoCo alone would weld it; --keep-welded checks it welded)",
+                b.name
+            ),
         });
     }
     Ok(Asset {

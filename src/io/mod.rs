@@ -6,6 +6,7 @@ pub mod asset;
 pub mod glb_write;
 pub mod gltf;
 pub mod mjcf;
+pub mod mjcf_frames;
 pub mod msh;
 pub mod obj;
 pub mod stl;

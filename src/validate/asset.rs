@@ -208,6 +208,9 @@ pub fn check_asset(a: &Asset, shown: &str, opts: &AssetCheckOptions) -> AssetRep
         .map(|(b, s)| s.iter().map(|x| world_hull(&x.2, &place(b))).collect())
         .collect();
     let mut inertia_ok = true;
+    // Bodies whose authored tensor is a placeholder: simulated with the one their geometry
+    // implies (one defect, one finding; see `physics_inertia`).
+    let mut substitute: Vec<(String, nalgebra::Matrix3<f64>)> = Vec::new();
     for (bi, b) in a.bodies.iter().enumerate() {
         let name = &b.name;
         let all_pts: Vec<P3> = body_shapes[bi]
@@ -279,6 +282,7 @@ pub fn check_asset(a: &Asset, shown: &str, opts: &AssetCheckOptions) -> AssetRep
                             .map(|k| (e[k] / ge[k]).max(ge[k] / e[k]))
                             .fold(0.0f64, f64::max);
                         if ratio > opts.max_inertia_ratio {
+                            substitute.push((name.clone(), implied.inertia));
                             add(
                                 "inertia.placeholder",
                                 name,
@@ -493,6 +497,9 @@ pub fn check_asset(a: &Asset, shown: &str, opts: &AssetCheckOptions) -> AssetRep
     for b in &mut assembly.bodies {
         b.pose.translation.vector.z += lift;
         b.composed_pose = b.pose;
+        if let Some((_, t)) = substitute.iter().find(|s| s.0 == b.name) {
+            b.inertial.inertia = *t;
+        }
     }
     let dynamic = assembly.bodies.iter().any(|b| !b.fixed);
     if !opts.physics {
@@ -527,11 +534,16 @@ pub fn check_asset(a: &Asset, shown: &str, opts: &AssetCheckOptions) -> AssetRep
                         file: a.file.clone(),
                         line: 0,
                     });
+                    let note = if substitute.iter().any(|s| s.0 == c.subject) {
+                        " (simulated with the inertia its geometry implies: the authored one is a placeholder)"
+                    } else {
+                        ""
+                    };
                     add(
                         &format!("physics.{}", c.name),
                         &c.subject,
                         &src,
-                        c.message,
+                        format!("{}{note}", c.message),
                         Some(c.value),
                         Some(c.limit),
                     );

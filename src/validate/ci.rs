@@ -1,7 +1,8 @@
 //! Many assets at once, for CI: discovery of files, folders and globs, the parallel run, and
 //! the outputs (table, JSON, SARIF 2.1.0, GitHub annotations, JUnit, baselines).
 //!
-//! Entry points: [`discover`], [`run`] ([`RunOptions`] → [`Run`]), [`table`], [`json`],
+//! Entry points: [`discover`], [`changed_since`] (`--changed-since REF`), [`run`]
+//! ([`RunOptions`] → [`Run`]), [`table`], [`json`],
 //! [`sarif`], [`github`], [`junit`], [`read_baseline`], [`baseline_json`], [`exit_code`].
 
 use super::asset::{check_path, AssetCheckOptions};
@@ -105,7 +106,7 @@ pub fn discover(paths: &[String]) -> Result<Vec<Entry>> {
             let kind = if is_model_file(p)
                 || matches!(
                     p.extension().and_then(|e| e.to_str()),
-                    Some("xml" | "urdf" | "mjcf")
+                    Some("xml" | "urdf" | "mjcf" | "xacro")
                 ) {
                 Kind::Asset
             } else {
@@ -568,4 +569,100 @@ pub fn baseline_json(r: &Run) -> Value {
         .map(|f| f.fingerprint.as_str())
         .collect();
     json!({"version": 1, "tool": "interact3d validate", "fingerprints": fps})
+}
+
+/// Files changed since a git revision in the repository holding `dir`: `git diff --name-only
+/// REF` (committed and uncommitted changes) plus untracked files, as absolute paths.
+pub fn changed_files(dir: &Path, git_ref: &str) -> Result<BTreeSet<PathBuf>> {
+    let git = |args: &[&str]| -> Result<String> {
+        let out = std::process::Command::new("git")
+            .arg("-C")
+            .arg(dir)
+            .args(args)
+            .output()
+            .map_err(|e| Error::Usage(format!("--changed-since needs git: {e}")))?;
+        if !out.status.success() {
+            return Err(Error::Usage(format!(
+                "--changed-since {git_ref}: git {}: {}",
+                args.join(" "),
+                String::from_utf8_lossy(&out.stderr).trim()
+            )));
+        }
+        Ok(String::from_utf8_lossy(&out.stdout).into_owned())
+    };
+    let top = PathBuf::from(git(&["rev-parse", "--show-toplevel"])?.trim());
+    let mut out = BTreeSet::new();
+    for list in [
+        git(&["diff", "--name-only", git_ref, "--"])?,
+        git(&["ls-files", "--others", "--exclude-standard"])?,
+    ] {
+        for l in list.lines().filter(|l| !l.is_empty()) {
+            let p = top.join(l);
+            out.insert(p.canonicalize().unwrap_or(p));
+        }
+    }
+    Ok(out)
+}
+
+/// The files an asset reads: itself, its includes and its meshes (as far as it can be read).
+fn referenced_files(e: &Entry, read: &crate::io::asset::ReadOptions) -> Vec<PathBuf> {
+    let mut v = vec![e.path.clone()];
+    if e.kind == Kind::Asset {
+        if let Ok(a) = crate::io::asset::load(&e.path, read) {
+            for b in &a.bodies {
+                v.push(b.src.file.clone());
+                for g in &b.geoms {
+                    v.push(g.src.file.clone());
+                    if let crate::io::asset::Shape::Mesh { file, .. } = &g.shape {
+                        v.push(file.clone());
+                    }
+                }
+            }
+            v.extend(a.issues.iter().map(|i| i.src.file.clone()));
+        }
+    }
+    v
+}
+
+/// Only the entries whose file, included files or meshes are among `changed` (absolute paths);
+/// a scene folder is kept when anything under it changed.
+pub fn changed_only(
+    entries: Vec<Entry>,
+    changed: &BTreeSet<PathBuf>,
+    read: &crate::io::asset::ReadOptions,
+) -> Vec<Entry> {
+    let abs = |p: &Path| p.canonicalize().unwrap_or_else(|_| p.to_path_buf());
+    entries
+        .into_iter()
+        .filter(|e| match e.kind {
+            Kind::Scene if e.path.is_dir() => {
+                let d = abs(&e.path);
+                changed.iter().any(|c| c.starts_with(&d))
+            }
+            _ => referenced_files(e, read)
+                .iter()
+                .any(|f| changed.contains(&abs(f))),
+        })
+        .collect()
+}
+
+/// `--changed-since`: the entries that read a file changed since `git_ref` in the repository of
+/// `first` (the first path given: a folder, or a file's folder; else the working directory).
+pub fn changed_since(
+    entries: Vec<Entry>,
+    first: &str,
+    git_ref: &str,
+    read: &crate::io::asset::ReadOptions,
+) -> Result<Vec<Entry>> {
+    let first = Path::new(first);
+    let dir = if first.is_dir() {
+        first.to_path_buf()
+    } else {
+        first
+            .parent()
+            .filter(|p| p.is_dir() && !p.as_os_str().is_empty())
+            .map(Path::to_path_buf)
+            .unwrap_or_else(|| PathBuf::from("."))
+    };
+    Ok(changed_only(entries, &changed_files(&dir, git_ref)?, read))
 }

@@ -32,6 +32,7 @@ pub const CHECKS: &[(&str, Severity, &str)] = &[
     ("file.mesh_unreadable", Severity::Error, "A mesh file exists but cannot be read."),
     ("file.unsupported", Severity::Note, "Something in the file is not read (a geom type); it is left out of the checks."),
     ("asset.articulated", Severity::Warning, "Moving joints: an articulated robot, out of scope; its links are checked as one rigid part."),
+    ("asset.free_object", Severity::Note, "An MJCF object model file (one body, no joint, no floor): checked as a free object on a ground plane."),
     ("inertia.positive_definite", Severity::Error, "Mass and principal moments of inertia must be positive."),
     ("inertia.triangle_inequality", Severity::Error, "Principal moments must satisfy A + B >= C (MuJoCo refuses the model otherwise)."),
     ("inertia.placeholder", Severity::Warning, "Authored principal moments are far from what the geometry and mass imply (a placeholder such as I = 1 kg·m²)."),
