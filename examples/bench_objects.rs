@@ -21,10 +21,6 @@ use interact3d::mesh::P3;
 use std::path::PathBuf;
 use std::time::Instant;
 
-/// The allocator of the `interact3d` binary, so the times are the command's.
-#[global_allocator]
-static ALLOC: mimalloc::MiMalloc = mimalloc::MiMalloc;
-
 fn shared() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../shared")
 }

@@ -27,10 +27,6 @@ use std::process::Command;
 use std::sync::Mutex;
 use std::time::Instant;
 
-/// The allocator of the `interact3d` binary, so the times are the command's.
-#[global_allocator]
-static ALLOC: mimalloc::MiMalloc = mimalloc::MiMalloc;
-
 /// Process CPU time (user + system, all threads) in seconds.
 fn cpu_s() -> f64 {
     let Ok(s) = std::fs::read_to_string("/proc/self/stat") else {

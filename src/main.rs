@@ -10,10 +10,6 @@ use interact3d::Error;
 use std::path::PathBuf;
 use std::process::ExitCode;
 
-/// mimalloc, not glibc's malloc: the same output for 10 % less CPU (see Cargo.toml).
-#[global_allocator]
-static ALLOC: mimalloc::MiMalloc = mimalloc::MiMalloc;
-
 #[derive(Parser)]
 #[command(
     name = "interact3d",
