@@ -9,7 +9,7 @@
 //! Objects model.xml under ../shared/datasets/objects, cycled to N. Each asset is timed alone
 //! on one thread (all checks, physics included), then the N together in parallel. simcheck
 //! (`simcheck check --no-cache FILE`, its engines MuJoCo and PyBullet: pip `simcheck`, pinned
-//! in tests/python/requirements-bench.txt) runs on the same N assets, one at a time (its cache
+//! in tests/python/requirements-simcheck.txt) runs on the same N assets, one at a time (its cache
 //! off, so a repeated file costs what it costs the first time); `--simcheck-n K` stops it after
 //! the first K. A second table gives each distinct file's mean and worst for both tools.
 
