@@ -797,3 +797,49 @@ fn changed_since_checks_only_assets_whose_file_or_mesh_changed() {
         2
     );
 }
+
+#[test]
+fn primitive_contact_depths_are_exact_not_tessellated() {
+    // A sphere turned so no tessellation vertex is lowest, its centre h = 47 mm above the floor
+    // (r = 50 mm): depth r − h = 3 mm. Two spheres (30 mm, 20 mm) whose centres are
+    // r1 + r2 − d apart along (1,2,2)/3, d = 2 mm: depth d. A 16×32 sphere read 2.907 and 1.678 mm.
+    let t = tempfile::tempdir().unwrap();
+    let (d, k) = (0.002, 0.048 / 3.0);
+    let xml = format!(
+        r#"<mujoco model="spheres">
+  <worldbody>
+    <geom name="floor" type="plane" size="1 1 0.1"/>
+    <body name="sunk" pos="0.3 0 0.047">
+      <freejoint/>
+      <geom type="sphere" size="0.05" euler="13 7 29" density="500"/>
+    </body>
+    <body name="p" pos="-0.3 0 0.2">
+      <freejoint/>
+      <geom type="sphere" size="0.03" density="500"/>
+    </body>
+    <body name="q" pos="{} {} {}">
+      <freejoint/>
+      <geom type="sphere" size="0.02" euler="31 -11 5" density="500"/>
+    </body>
+  </worldbody>
+</mujoco>
+"#,
+        -0.3 + k,
+        2.0 * k,
+        0.2 + 2.0 * k
+    );
+    let p = write(t.path(), "spheres.xml", &xml);
+    let r = check(&p);
+    let f = find(&r, "contact.floor");
+    assert_eq!(f.len(), 1, "{:#?}", r.findings);
+    assert_eq!(f[0].subject, "sunk");
+    assert!(
+        (f[0].value.unwrap() - 0.003).abs() < 1e-9,
+        "{:?}",
+        f[0].value
+    );
+    let f = find(&r, "contact.penetration");
+    assert_eq!(f.len(), 1, "{:#?}", r.findings);
+    assert_eq!(f[0].subject, "p/q");
+    assert!((f[0].value.unwrap() - d).abs() < 1e-9, "{:?}", f[0].value);
+}

@@ -5,17 +5,18 @@
 //!
 //! Geometry is what the engines collide: the convex hull of every collision mesh piece (OBJ
 //! groups of a URDF are separate pieces, as PyBullet loads them; an MJCF mesh is one hull, as
-//! MuJoCo loads it) and tessellated primitives. Contact depths are exact f64 convex queries;
+//! MuJoCo loads it) and, for the bounding checks, tessellated primitives. Contact depths use
+//! parry's exact boxes, spheres, capsules and cylinders ([`super::contact`]; ellipsoids and
+//! meshes as hulls) in f64;
 //! the settle and rest tests are [`crate::physics::settle`] through [`super::dynamic_checks`].
 
+use super::contact::{self, Collider};
 use super::finding::{AssetReport, Finding, CHECKS};
 use crate::decompose::Hull;
 use crate::io::asset::{geometric_inertial, Asset, AssetBody, ReadOptions, Shape, Source};
 use crate::mesh::{Aabb, Mesh, P3};
 use crate::physics::SettleOptions;
 use nalgebra::Isometry3;
-use parry3d_f64::query;
-use parry3d_f64::shape::ConvexPolyhedron;
 use std::path::Path;
 
 /// Thresholds of the asset checks.
@@ -108,10 +109,16 @@ pub fn check_path(path: &Path, shown: &str, opts: &AssetCheckOptions) -> AssetRe
 }
 
 /// Convex shapes of a body in the body frame: (geom name, its source, hull).
-fn shapes(b: &AssetBody) -> Vec<(String, Source, Hull, Option<Mesh>)> {
+/// Primitives also carry their exact shape (core, radius, pose in the body frame), which the
+/// contact depths use; their tessellated hull serves the bounding checks.
+type BodyShape = (String, Source, Hull, Option<Mesh>, Option<Primitive>);
+type Primitive = (parry3d_f64::shape::SharedShape, f64, Isometry3<f64>);
+
+fn shapes(b: &AssetBody) -> Vec<BodyShape> {
     let mut out = Vec::new();
     for g in b.geoms.iter().filter(|g| g.collision) {
         let is_mesh = matches!(g.shape, Shape::Mesh { .. });
+        let exact = contact::exact_primitive(g);
         let meshes = g.body_meshes();
         let n = meshes.len();
         for (k, m) in meshes.into_iter().enumerate() {
@@ -122,7 +129,7 @@ fn shapes(b: &AssetBody) -> Vec<(String, Source, Hull, Option<Mesh>)> {
                 } else {
                     g.name.clone()
                 };
-                out.push((name, g.src.clone(), h, is_mesh.then_some(m)));
+                out.push((name, g.src.clone(), h, is_mesh.then_some(m), exact.clone()));
             }
         }
     }
@@ -146,11 +153,6 @@ fn polygon_count(h: &Hull) -> usize {
 
 fn world_hull(h: &Hull, pose: &Isometry3<f64>) -> Hull {
     h.transformed(pose)
-}
-
-fn poly(h: &Hull) -> Option<ConvexPolyhedron> {
-    let pts: Vec<_> = h.vertices.iter().map(crate::mesh::to_dvec).collect();
-    ConvexPolyhedron::from_convex_hull(&pts)
 }
 
 /// Run every check on an asset read without error.
@@ -358,7 +360,7 @@ pub fn check_asset(a: &Asset, shown: &str, opts: &AssetCheckOptions) -> AssetRep
                 );
             }
         }
-        for (si, (gname, src, h, mesh)) in body_shapes[bi].iter().enumerate() {
+        for (si, (gname, src, h, mesh, _)) in body_shapes[bi].iter().enumerate() {
             let polys = polygon_count(h);
             let nv = h.vertices.len();
             // Primitives are analytic shapes in every engine; only meshes are cooked.
@@ -423,31 +425,30 @@ pub fn check_asset(a: &Asset, shown: &str, opts: &AssetCheckOptions) -> AssetRep
             }
         }
     }
-    // Contact at the initial pose.
-    let polys: Vec<Vec<Option<ConvexPolyhedron>>> = world
+    // Contact at the initial pose: exact primitives, hulls of meshes and ellipsoids.
+    let colliders: Vec<Vec<Collider>> = a
+        .bodies
         .iter()
-        .map(|hs| hs.iter().map(poly).collect())
+        .enumerate()
+        .map(|(i, b)| {
+            body_shapes[i]
+                .iter()
+                .zip(&world[i])
+                .filter_map(|(s, wh)| match &s.4 {
+                    Some((core, r, local)) => {
+                        Some(Collider::primitive(core.clone(), *r, local, &place(b)))
+                    }
+                    None => Collider::hull(wh),
+                })
+                .collect()
+        })
         .collect();
     for i in 0..a.bodies.len() {
         for j in i + 1..a.bodies.len() {
             if a.bodies[i].fixed && a.bodies[j].fixed {
                 continue;
             }
-            let mut deepest = 0.0f64;
-            for (hi, pi) in world[i].iter().zip(&polys[i]) {
-                for (hj, pj) in world[j].iter().zip(&polys[j]) {
-                    if !hi.aabb.intersects(&hj.aabb, 0.0) {
-                        continue;
-                    }
-                    let (Some(pi), Some(pj)) = (pi, pj) else {
-                        continue;
-                    };
-                    let id = parry3d_f64::math::Pose::identity();
-                    if let Ok(Some(c)) = query::contact(&id, pi, &id, pj, 0.0) {
-                        deepest = deepest.max(-c.dist);
-                    }
-                }
-            }
+            let deepest = contact::pair_depth(&colliders[i], &colliders[j]);
             if deepest > opts.max_penetration {
                 let (bi, bj) = (&a.bodies[i], &a.bodies[j]);
                 add(
@@ -466,11 +467,7 @@ pub fn check_asset(a: &Asset, shown: &str, opts: &AssetCheckOptions) -> AssetRep
     }
     if a.floor.is_some() {
         for (i, b) in a.bodies.iter().enumerate() {
-            let low = world[i]
-                .iter()
-                .flat_map(|h| h.vertices.iter())
-                .map(|p| p.z)
-                .fold(f64::INFINITY, f64::min);
+            let low = contact::lowest_z(&colliders[i]);
             if -low > opts.max_penetration {
                 add(
                     "contact.floor",

@@ -17,6 +17,7 @@
 
 pub mod asset;
 pub mod ci;
+pub mod contact;
 pub mod finding;
 
 use crate::body::Assembly;
