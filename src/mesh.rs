@@ -318,6 +318,18 @@ impl VisualMesh {
         m.welded(0.0)
     }
 
+    /// Total surface area of all parts (triangles summed in order, parts in order).
+    pub fn area(&self) -> f64 {
+        self.parts
+            .iter()
+            .flat_map(|p| {
+                p.triangles
+                    .iter()
+                    .map(|t| triangle_area(&t.map(|k| p.positions[k as usize])))
+            })
+            .sum()
+    }
+
     /// Number of triangles over all parts.
     pub fn triangle_count(&self) -> usize {
         self.parts.iter().map(|p| p.triangles.len()).sum()

@@ -9,7 +9,7 @@
 use super::cloud::Cloud;
 use super::kdtree::KdTree;
 use super::plane_icp::surface_fit;
-use crate::mesh::{triangle_area, VisualMesh, P3};
+use crate::mesh::{VisualMesh, P3};
 use crate::pose::Similarity;
 use serde::Serialize;
 
@@ -40,15 +40,7 @@ pub struct Guard<'a> {
 
 /// Mean sample spacing of `n` samples on `visual`'s surface (object units).
 pub fn spacing(visual: &VisualMesh, n: usize) -> f64 {
-    let area: f64 = visual
-        .parts
-        .iter()
-        .flat_map(|p| {
-            p.triangles
-                .iter()
-                .map(|t| triangle_area(&t.map(|k| p.positions[k as usize])))
-        })
-        .sum();
+    let area = visual.area();
     (area / n.max(1) as f64).sqrt()
 }
 

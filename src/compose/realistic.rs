@@ -287,15 +287,7 @@ pub fn make(objects: &[TruthObject], seed: u64, o: &RealisticOptions) -> Synthet
         ) * diag,
     };
     let truth: Vec<Similarity> = objects.iter().map(|t| frame.then_after(&t.pose)).collect();
-    let placed: Vec<VisualMesh> = objects
-        .iter()
-        .zip(&truth)
-        .map(|(t, s)| {
-            let mut v = t.visual.clone();
-            v.transform(&s.matrix());
-            v
-        })
-        .collect();
+    let placed = super::synth::placed(objects, &truth);
     let clouds: Vec<Cloud> = placed
         .iter()
         .enumerate()
@@ -415,15 +407,7 @@ impl AddS {
         let model = Cloud::sample(visual, 2000, 0xADD5).points;
         let dense = Cloud::sample(visual, 40_000, 0xADD6);
         let tree = KdTree::new(&dense.points);
-        let area: f64 = visual
-            .parts
-            .iter()
-            .flat_map(|p| {
-                p.triangles
-                    .iter()
-                    .map(|t| triangle_area(&t.map(|k| p.positions[k as usize])))
-            })
-            .sum();
+        let area = visual.area();
         AddS {
             model,
             dense,

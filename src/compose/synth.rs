@@ -241,15 +241,7 @@ pub fn make(objects: &[TruthObject], seed: u64, o: &SynthOptions) -> Synthetic {
         ) * diag,
     };
     let truth: Vec<Similarity> = objects.iter().map(|t| frame.then_after(&t.pose)).collect();
-    let placed: Vec<VisualMesh> = objects
-        .iter()
-        .zip(&truth)
-        .map(|(t, s)| {
-            let mut v = t.visual.clone();
-            v.transform(&s.matrix());
-            v
-        })
-        .collect();
+    let placed = placed(objects, &truth);
     // Dense points of every placed object, for contact and fusing.
     let clouds: Vec<super::cloud::Cloud> = placed
         .iter()
@@ -616,4 +608,17 @@ pub fn symmetric_scenes() -> Vec<(String, Vec<TruthObject>)> {
             ],
         ),
     ]
+}
+
+/// Each object's visual mesh moved by its truth (object frame → guidance frame).
+pub(crate) fn placed(objects: &[TruthObject], truth: &[Similarity]) -> Vec<VisualMesh> {
+    objects
+        .iter()
+        .zip(truth)
+        .map(|(t, s)| {
+            let mut v = t.visual.clone();
+            v.transform(&s.matrix());
+            v
+        })
+        .collect()
 }
