@@ -426,7 +426,7 @@ fn main() {
     };
 
     println!("## Per mesh\n");
-    println!("Distances in % of the bbox diagonal. h→m: hull-union boundary → mesh surface; m→h: mesh surface → hull-union boundary; p95 = the larger of the two 95th percentiles (the headline); outside: depth of the mesh surface outside every hull. Limits: ≤ {} hulls (ours, parry's V-HACD; CoACD 32x64 and V-HACD 4: 32), ≤ {} vertices per hull (CoACD at its defaults has neither limit).\n", opts.max_hulls, opts.max_vertices);
+    println!("Distances in % of the bbox diagonal. h→m: hull-union boundary → mesh surface; m→h: mesh surface → hull-union boundary; p95 = the larger of the two 95th percentiles (the headline); outside: depth of the mesh surface outside every hull. CoACD 32x64's and V-HACD 4's h→m counts the inner faces of hulls that do not meet (slots through the solid; docs/collision_fit.md). Limits: ≤ {} hulls (ours, parry's V-HACD; CoACD 32x64 and V-HACD 4: 32), ≤ {} vertices per hull (CoACD at its defaults has neither limit).\n", opts.max_hulls, opts.max_vertices);
     println!("| mesh | triangles | engine | time (s) | hulls | max verts | hull vol / mesh vol | h→m p95 % | m→h p95 % | **p95 %** | outside p99 % | outside max % | h→m max % | uncovered % | cavity kept |");
     println!("|---|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---|");
     // Per object row: (label, engine → (seconds, figures)).
