@@ -21,18 +21,9 @@ use std::path::{Path, PathBuf};
 use std::process::Command;
 use std::time::Instant;
 
-fn peak_rss_mib() -> f64 {
-    std::fs::read_to_string("/proc/self/status")
-        .ok()
-        .and_then(|s| {
-            s.lines()
-                .find(|l| l.starts_with("VmHWM:"))
-                .and_then(|l| l.split_whitespace().nth(1))
-                .and_then(|kb| kb.parse::<f64>().ok())
-        })
-        .map(|kb| kb / 1024.0)
-        .unwrap_or(f64::NAN)
-}
+#[path = "common/procstat.rs"]
+mod procstat;
+use procstat::peak_rss_mib;
 
 /// In the child: run one batch, print "scenes elapsed_s peak_rss_mib converted".
 fn child(root: &Path, out: &Path, jobs: usize) {

@@ -21,22 +21,12 @@ use interact3d::mesh::P3;
 use std::path::PathBuf;
 use std::time::Instant;
 
+#[path = "common/procstat.rs"]
+mod procstat;
+use procstat::cpu_s;
+
 fn shared() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../shared")
-}
-
-/// Process CPU time (user + system, all threads) in seconds.
-fn cpu_s() -> f64 {
-    let Ok(s) = std::fs::read_to_string("/proc/self/stat") else {
-        return f64::NAN;
-    };
-    let rest = s.rsplit_once(") ").map(|(_, r)| r).unwrap_or("");
-    let f: Vec<&str> = rest.split_whitespace().collect();
-    let ticks = |i: usize| f.get(i).and_then(|v| v.parse::<f64>().ok());
-    match (ticks(11), ticks(12)) {
-        (Some(u), Some(s)) => (u + s) / 100.0,
-        _ => f64::NAN,
-    }
 }
 
 /// FNV-1a over the bits of every vertex coordinate, hull by hull, continuing from `h`.

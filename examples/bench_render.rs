@@ -17,22 +17,9 @@ use interact3d::render::{png_bytes, render, RenderOptions};
 use std::path::PathBuf;
 use std::time::Instant;
 
-/// CPU seconds (user + system) of this process so far: on a shared machine the wall clock
-/// also counts the time other processes had the core.
-fn cpu_s() -> f64 {
-    let stat = std::fs::read_to_string("/proc/self/stat").unwrap_or_default();
-    let after = stat.rsplit_once(')').map(|x| x.1).unwrap_or("");
-    let f: Vec<f64> = after
-        .split_whitespace()
-        .filter_map(|x| x.parse().ok())
-        .collect();
-    // Fields 14 and 15 of stat (utime, stime); the numbers after the name start at field 4.
-    if f.len() > 11 {
-        (f[10] + f[11]) / 100.0
-    } else {
-        f64::NAN
-    }
-}
+#[path = "common/procstat.rs"]
+mod procstat;
+use procstat::cpu_s;
 
 fn main() {
     let mut scenes: Vec<PathBuf> = std::env::args().skip(1).map(PathBuf::from).collect();
