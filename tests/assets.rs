@@ -202,7 +202,11 @@ fn geometry_checks() {
         ids(&r)
     );
     // GPU twin: a box mesh of 8 vertices and 6 polygons.
-    let cube = write(t.path(), "cube.obj", "o c\nv -0.03 -0.03 -0.03\nv 0.03 -0.03 -0.03\nv 0.03 0.03 -0.03\nv -0.03 0.03 -0.03\nv -0.03 -0.03 0.03\nv 0.03 -0.03 0.03\nv 0.03 0.03 0.03\nv -0.03 0.03 0.03\nf 1 3 2\nf 1 4 3\nf 5 6 7\nf 5 7 8\nf 1 2 6\nf 1 6 5\nf 2 3 7\nf 2 7 6\nf 3 4 8\nf 3 8 7\nf 4 1 5\nf 4 5 8\n");
+    let cube = write(
+        t.path(),
+        "cube.obj",
+        &format!("o c\n{}", box_obj([0.03; 3])),
+    );
     let cm = urdf(
         &inertial(0.2, box_inertia(0.2, [0.06; 3]), [0.0; 3]),
         "<mesh filename=\"cube.obj\"/>",
@@ -591,7 +595,7 @@ fn cli_outputs_and_exit_codes() {
 #[test]
 fn frames_replicate_and_mesh_reference_agree_with_mujoco() {
     let t = tempfile::tempdir().unwrap();
-    write(t.path(), "cube.obj", "v -0.02 -0.01 -0.03\nv 0.02 -0.01 -0.03\nv 0.02 0.01 -0.03\nv -0.02 0.01 -0.03\nv -0.02 -0.01 0.03\nv 0.02 -0.01 0.03\nv 0.02 0.01 0.03\nv -0.02 0.01 0.03\nf 1 3 2\nf 1 4 3\nf 5 6 7\nf 5 7 8\nf 1 2 6\nf 1 6 5\nf 2 3 7\nf 2 7 6\nf 3 4 8\nf 3 8 7\nf 4 1 5\nf 4 5 8\n");
+    write(t.path(), "cube.obj", &box_obj([0.02, 0.01, 0.03]));
     let xml = r#"<mujoco>
   <asset>
     <mesh name="m" file="cube.obj" scale="1 2 1" refpos="0.01 0 -0.02" refquat="0.9238795 0 0 0.3826834"/>
@@ -707,22 +711,18 @@ fn changed_since_checks_only_assets_whose_file_or_mesh_changed() {
             String::from_utf8_lossy(&o.stderr)
         );
     };
-    let cube = |s: f64| {
-        let v: String = [
-            (-1, -1, -1),
-            (1, -1, -1),
-            (1, 1, -1),
-            (-1, 1, -1),
-            (-1, -1, 1),
-            (1, -1, 1),
-            (1, 1, 1),
-            (-1, 1, 1),
-        ]
-        .iter()
-        .map(|(x, y, z)| format!("v {} {} {}\n", *x as f64 * s, *y as f64 * s, *z as f64 * s))
-        .collect();
-        v + "f 1 3 2\nf 1 4 3\nf 5 6 7\nf 5 7 8\nf 1 2 6\nf 1 6 5\nf 2 3 7\nf 2 7 6\nf 3 4 8\nf 3 8 7\nf 4 1 5\nf 4 5 8\n"
+    let commit = |msg: &str| {
+        git(&[
+            "-c",
+            "user.name=t",
+            "-c",
+            "user.email=t@t",
+            "commit",
+            "-qm",
+            msg,
+        ])
     };
+    let cube = |s: f64| box_obj([s; 3]);
     for n in ["a", "b", "c"] {
         write(d, &format!("{n}.obj"), &cube(0.03));
         write(
@@ -737,15 +737,7 @@ fn changed_since_checks_only_assets_whose_file_or_mesh_changed() {
     }
     git(&["init", "-q"]);
     git(&["add", "."]);
-    git(&[
-        "-c",
-        "user.name=t",
-        "-c",
-        "user.email=t@t",
-        "commit",
-        "-qm",
-        "assets",
-    ]);
+    commit("assets");
     // b's mesh changes (uncommitted), c's URDF is untouched, d is new and untracked.
     write(d, "b.obj", &cube(0.031));
     write(
@@ -779,15 +771,7 @@ fn changed_since_checks_only_assets_whose_file_or_mesh_changed() {
     assert_eq!(files, vec!["b.urdf", "d.urdf"], "{err}");
     // Nothing changed since the working tree: nothing to check, exit 0; a bad revision: 2.
     git(&["add", "."]);
-    git(&[
-        "-c",
-        "user.name=t",
-        "-c",
-        "user.email=t@t",
-        "commit",
-        "-qm",
-        "more",
-    ]);
+    commit("more");
     let (code, out, _) = run(&["validate", dir, "--changed-since", "HEAD", "--json"]);
     assert_eq!(code, 0);
     let j: serde_json::Value = serde_json::from_str(&out).unwrap();

@@ -55,6 +55,32 @@ pub fn write(dir: &Path, name: &str, text: &str) -> PathBuf {
 }
 
 /// A one-link URDF: `inertial` and `geometry` blocks as given.
+/// A closed box of half-extents `h` centred at the origin as OBJ text (8 vertices, 12 outward
+/// triangles).
+pub fn box_obj(h: [f64; 3]) -> String {
+    let v: String = [
+        (-1, -1, -1),
+        (1, -1, -1),
+        (1, 1, -1),
+        (-1, 1, -1),
+        (-1, -1, 1),
+        (1, -1, 1),
+        (1, 1, 1),
+        (-1, 1, 1),
+    ]
+    .iter()
+    .map(|(x, y, z)| {
+        format!(
+            "v {} {} {}\n",
+            *x as f64 * h[0],
+            *y as f64 * h[1],
+            *z as f64 * h[2]
+        )
+    })
+    .collect();
+    v + "f 1 3 2\nf 1 4 3\nf 5 6 7\nf 5 7 8\nf 1 2 6\nf 1 6 5\nf 2 3 7\nf 2 7 6\nf 3 4 8\nf 3 8 7\nf 4 1 5\nf 4 5 8\n"
+}
+
 pub fn urdf(inertial: &str, visual: &str, collision: &str) -> String {
     format!(
         "<?xml version=\"1.0\"?>\n<robot name=\"t\">\n  <link name=\"obj\">\n{inertial}\n    <visual><geometry>{visual}</geometry></visual>\n    <collision><geometry>{collision}</geometry></collision>\n  </link>\n</robot>\n"
