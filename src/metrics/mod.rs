@@ -469,10 +469,25 @@ fn classify_column(
             }
         }
         Shape::Hulls(hs) => {
+            // Only the hulls whose box the column passes through can hold its points: the
+            // others fail `Hull::contains`'s box test on the column's two fixed coordinates
+            // whatever `t`. Same answers, for a fraction of the box tests (a body of 32
+            // hulls is crossed by a few): validation of `00002_fruit_bowl` spent 26 % of its
+            // time in this loop.
+            let crossed: Vec<&Hull> = hs
+                .iter()
+                .filter(|h| {
+                    uv.iter()
+                        .all(|&k| h.bb.min[k] <= base[k] && base[k] <= h.bb.max[k])
+                })
+                .collect();
+            if crossed.is_empty() {
+                return;
+            }
             for (o, &t) in out.iter_mut().zip(ts) {
                 let mut p = base;
                 p[axis] = t;
-                *o = hs.iter().any(|h| h.contains(p));
+                *o = crossed.iter().any(|h| h.contains(p));
             }
         }
     }
