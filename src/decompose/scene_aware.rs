@@ -110,7 +110,7 @@ use std::sync::Mutex;
 /// Engine name, recorded in reports and in the cache key.
 pub const NAME: &str = "scene_aware";
 /// Bumped whenever the output for the same input changes (invalidates the cache).
-pub const VERSION: u32 = 37;
+pub const VERSION: u32 = 36;
 
 /// The scene-aware engine. Holds the report of its last run (see [`SceneAware::last_report`]).
 #[derive(Debug, Default)]
@@ -638,21 +638,14 @@ fn build_new_part(
     if hull.vertices.len() > opts.max_vertices {
         hull = hull.simplified(opts.max_vertices)?;
     }
-    // The patch's own surface outside the hull counts too (see `fit::outside_depth`).
-    let out = fit::outside_depth(s, &hull, &tris, &cuts);
-    let dev = if out >= bound {
-        out
-    } else {
-        deviation_until(
-            s,
-            &hull,
-            tris[0] as u64,
-            &outer,
-            two_sided.then_some(p.seam_depth()),
-            bound,
-        )
-        .max(out)
-    };
+    let dev = deviation_until(
+        s,
+        &hull,
+        tris[0] as u64,
+        &outer,
+        two_sided.then_some(p.seam_depth()),
+        bound,
+    );
     Some(Part {
         tris,
         hull,

@@ -2,9 +2,7 @@
 //! the hulls, where the engine otherwise measures only from the hulls to the mesh, and what a
 //! cut against a neighbour leaves of a part. Entry points: [`mesh_side`] (the whole mesh
 //! against one hull, for the convex shortcut), [`kept_side`] (a part a neighbour cut would
-//! leave too thin, rebuilt from what the cut leaves of its patch instead of dropped) and
-//! [`outside_depth`] (how far a patch's own surface lies outside its hull, which counts in
-//! the part's deviation).
+//! leave too thin, rebuilt from what the cut leaves of its patch instead of dropped).
 
 use super::*;
 
@@ -53,36 +51,19 @@ pub(super) fn kept_side(
     build_part(s, p, opts, kept, cuts).filter(|q| q.hull.thickness() >= opts.min_thickness)
 }
 
-/// A patch vertex `OUTSIDE_WEIGHT × tolerance` outside its hull deviates as much as a hull
-/// point the tolerance from the mesh: the issue's target for the outside depth is half the
-/// tolerance (0.5 % of the diagonal at the 99th percentile).
-pub(super) const OUTSIDE_WEIGHT: f64 = 2.0;
-
-/// How far the patch `tris`'s own vertices lie outside the hull `h` (by its face planes, 0
-/// when all are inside), times [`OUTSIDE_WEIGHT`]: the part's deviation in the other
-/// direction. A wall segment spans at most `max_vertices/2` sampled vertices of each side and
-/// a one-sided patch `max_vertices/2` plus their pushed copies: between those the surface
-/// can bulge out of the hull, and nothing else measured it, so the quality loop never split
-/// such a patch (issue #35: the Reebok ZIGLITE's sole edge lay 1.3 % of the diagonal outside
-/// its forefoot segment, the YCB duplo's stud tops 2.1 % outside theirs). Vertices beyond a
-/// cut `cuts` (a neighbour's side) are not counted.
-pub(super) fn outside_depth(s: &Surface, h: &Hull, tris: &[u32], cuts: &[(V3, f64)]) -> f64 {
-    let mut far: f64 = 0.0;
-    for i in s.vertices_of(tris) {
-        let q = &s.mesh.vertices[i as usize];
-        if h.within_planes(q, far) || cuts.iter().any(|(n, c)| n.dot(&q.coords) > *c) {
-            continue;
-        }
-        far = far.max(h.plane_distance(q));
-    }
-    OUTSIDE_WEIGHT * far
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::mesh::Mesh;
     use crate::shapes;
+
+    /// How far the vertices of `tris` lie outside `h` (by its face planes, 0 inside).
+    fn outside_depth(s: &Surface, h: &Hull, tris: &[u32]) -> f64 {
+        s.vertices_of(tris)
+            .iter()
+            .map(|&i| h.plane_distance(&s.mesh.vertices[i as usize]))
+            .fold(0.0, f64::max)
+    }
 
     /// Two closed boxes as one mesh: a 100 × 100 × 10 mm slab and, 0.5 mm above its top, a
     /// 4 × 4 × 2 mm tile near one corner (all in m).
@@ -126,11 +107,11 @@ mod tests {
             .collect();
         assert_eq!(top.len(), 4);
         let part = build_part(&s, &p, &opts, top.clone(), Vec::new()).unwrap();
-        // The hull is the slab's top, the tile 2.5 mm above it (and counted in `dev`).
+        // The hull is the slab's top, the tile 2.5 mm above it.
         let tile_top = P3::new(0.084, 0.084, 0.0125);
         let above = part.hull.plane_distance(&tile_top);
         assert!((above - 0.0025).abs() < 1e-9, "{above}");
-        assert!(part.dev >= OUTSIDE_WEIGHT * above - 1e-12, "{}", part.dev);
+        assert!((outside_depth(&s, &part.hull, &part.tris) - 0.0025).abs() < 1e-9);
         let (n, c) = (-V3::z(), -0.0102);
         assert!(clip(&part.hull, &n, c).is_none(), "the cut leaves nothing");
         let obj = Obj {
@@ -158,7 +139,7 @@ mod tests {
         assert!((q.hull.thickness() - d_max).abs() < 1e-12);
         assert!(q.hull.thickness() >= opts.min_thickness);
         // The tile's top is covered again: no patch vertex outside the rebuilt hull.
-        assert!(outside_depth(&s, &q.hull, &q.tris, &q.cuts) < 1e-12);
+        assert!(outside_depth(&s, &q.hull, &q.tris) < 1e-12);
     }
 
     /// Without vertices of the patch on the kept side (the cut above the tile too) nothing is

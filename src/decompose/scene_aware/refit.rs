@@ -42,7 +42,7 @@
 
 use super::geom::{sample_triangles, Surface};
 use super::rebalance::pinned;
-use super::{deviation, fit, Params, Part};
+use super::{deviation, Params, Part};
 use crate::decompose::{DecomposeOptions, Hull};
 use crate::mesh::{P3, V3};
 use rayon::prelude::*;
@@ -85,8 +85,7 @@ pub(super) fn refit(
                 return 0;
             };
             // Every vertex of `g` is a mesh vertex: none needs a distance query.
-            q.dev = deviation(s, &g, q.tris[0] as u64, &g.vertices, Some(p.seam_depth()))
-                .max(fit::outside_depth(s, &g, &q.tris, &q.cuts));
+            q.dev = deviation(s, &g, q.tris[0] as u64, &g.vertices, Some(p.seam_depth()));
             q.outer = g.vertices.clone();
             q.hull = g;
             1
