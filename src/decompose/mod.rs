@@ -72,6 +72,35 @@ impl Default for DecomposeOptions {
     }
 }
 
+impl DecomposeOptions {
+    /// The options an engine builds hulls with so that they are within the polygon budget by
+    /// construction: with `max_polygons` set, at most `max_polygons / 2 + 2` vertices per hull.
+    /// A convex polyhedron of `V` vertices triangulates into exactly `2V − 4` triangles (Euler),
+    /// and merging coplanar ones only lowers the count, so such a hull never has more than
+    /// `max_polygons` polygons, whatever its shape (34 vertices for PhysX's 64; PhysX's own
+    /// re-cooking of round hulls also lands on 34). The engine's quality loop then measures
+    /// the hulls it will ship and splits where they deviate, instead of [`physx_legal`]
+    /// shrinking them after the fact (docs/usd.md has the cost of both). Without a polygon
+    /// budget the options are unchanged.
+    pub fn engine_budget(&self) -> DecomposeOptions {
+        let mut o = self.clone();
+        if self.max_polygons != usize::MAX {
+            o.max_vertices = self
+                .max_vertices
+                .min(self.max_polygons / 2 + 2)
+                .max(4);
+        }
+        o
+    }
+
+    /// PhysX's plane tolerance, with margin ([`PHYSX_PLANE_TOLERANCE`]), when hulls are built
+    /// for it (a polygon budget is set): every hull vertex must bulge out of the hull of the
+    /// others by more, or PhysX's cooking skips it. `None` without a polygon budget.
+    pub fn plane_tolerance(&self) -> Option<f64> {
+        (self.max_polygons != usize::MAX).then_some(PHYSX_PLANE_TOLERANCE)
+    }
+}
+
 /// A convex decomposition engine.
 pub trait Decomposer: Send + Sync {
     /// Short name, recorded in reports.
@@ -181,12 +210,18 @@ pub fn physx_legal(sets: &mut [Vec<Hull>], opts: &DecomposeOptions) -> Vec<Legal
     sets.iter_mut()
         .map(|hulls| {
             let (mut reduced, mut over) = (0, 0);
+            let seams = seam_vertices(hulls);
+            let pinned = |p: &crate::mesh::P3| {
+                seams
+                    .binary_search_by(|q| key_of(q).cmp(&key_of(p)))
+                    .is_ok()
+            };
             let mut out = Vec::with_capacity(hulls.len());
             for h in hulls.drain(..) {
                 let before = h.vertices.len();
                 let fallback = h.clone();
                 let h = match h
-                    .within(&limits)
+                    .within_pinned(&limits, &pinned)
                     .filter(|h| h.thickness() >= opts.min_thickness)
                 {
                     Some(h) => h,
@@ -224,4 +259,32 @@ pub fn physx_legal(sets: &mut [Vec<Hull>], opts: &DecomposeOptions) -> Vec<Legal
             }
         })
         .collect()
+}
+
+/// A point's coordinates as bits, to compare points exactly.
+fn key_of(p: &crate::mesh::P3) -> [u64; 3] {
+    [p.x.to_bits(), p.y.to_bits(), p.z.to_bits()]
+}
+
+/// The vertices (exactly equal coordinates) that two or more of `hulls` share, sorted by
+/// [`key_of`]: the seams where an object's pieces meet.
+fn seam_vertices(hulls: &[Hull]) -> Vec<crate::mesh::P3> {
+    let mut all: Vec<([u64; 3], usize)> = hulls
+        .iter()
+        .enumerate()
+        .flat_map(|(k, h)| h.vertices.iter().map(move |v| (key_of(v), k)))
+        .collect();
+    all.sort_unstable();
+    all.dedup();
+    let mut out: Vec<crate::mesh::P3> = Vec::new();
+    for w in all.windows(2) {
+        if w[0].0 == w[1].0 && out.last().is_none_or(|q| key_of(q) != w[0].0) {
+            out.push(crate::mesh::P3::new(
+                f64::from_bits(w[0].0[0]),
+                f64::from_bits(w[0].0[1]),
+                f64::from_bits(w[0].0[2]),
+            ));
+        }
+    }
+    out
 }
