@@ -173,7 +173,8 @@ fn sweep_objects(only: Option<&str>) {
     .unwrap();
     println!("| object | hulls free / engine | max polygons free | two-sided p95 free (%) | post-hoc (%) | engine (%) | post-hoc cost (pp) | engine cost (pp) | one-sided cost post-hoc / engine (pp) | free s | engine s |");
     println!("|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|");
-    let (mut post, mut eng, mut one_post, mut one_eng) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
+    let (mut post, mut eng, mut one_post, mut one_eng) =
+        (Vec::new(), Vec::new(), Vec::new(), Vec::new());
     let (mut hulls_total, mut hulls_over) = (0, 0);
     let limited = DecomposeOptions {
         max_polygons: interact3d::decompose::PHYSX_MAX_POLYGONS,

@@ -87,10 +87,7 @@ impl DecomposeOptions {
     pub fn engine_budget(&self) -> DecomposeOptions {
         let mut o = self.clone();
         if self.max_polygons != usize::MAX {
-            o.max_vertices = self
-                .max_vertices
-                .min(self.max_polygons / 2 + 2)
-                .max(4);
+            o.max_vertices = self.max_vertices.min(self.max_polygons / 2 + 2).max(4);
         }
         o
     }
