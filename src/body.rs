@@ -121,7 +121,7 @@ pub fn assemble(
     source: &std::path::Path,
 ) -> Result<Assembly> {
     let meshes: Vec<&Mesh> = prepared.objects.iter().map(|o| &o.geometry).collect();
-    let mut hull_sets = engine.decompose(&meshes, dopts)?;
+    let mut hull_sets = engine.decompose(&meshes, &dopts.engine_budget())?;
     let legal = crate::decompose::physx_legal(&mut hull_sets, dopts);
     let notes = engine.object_warnings();
     let mut bodies = Vec::with_capacity(prepared.objects.len());

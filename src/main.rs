@@ -260,7 +260,8 @@ struct BuildArgs {
     max_hull_vertices: usize,
     /// Most polygons per hull (coplanar triangles merged); 0: no limit. PhysX (Isaac) re-cooks
     /// a hull of more than 64 into another shape, silently: give 64 when exporting for Isaac
-    /// (it costs fidelity on round objects, see docs/usd.md).
+    /// (the engine then builds hulls of at most 34 vertices; it costs some fidelity on small
+    /// round objects, see docs/usd.md).
     #[arg(long, value_name = "N", default_value_t = 0)]
     max_hull_polygons: usize,
     /// V-HACD voxel resolution.

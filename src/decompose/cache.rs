@@ -81,6 +81,12 @@ pub fn key(engine: &str, version: u32, opts: &DecomposeOptions, objects: &[&Mesh
     h.update(opts.concavity.to_le_bytes());
     h.update(opts.tolerance.to_le_bytes());
     h.update(opts.clearance.to_le_bytes());
+    // Only with a polygon budget (the engine then builds for PhysX), so keys without one are
+    // what they were.
+    if opts.max_polygons != usize::MAX {
+        h.update(b"max_polygons");
+        h.update((opts.max_polygons as u64).to_le_bytes());
+    }
     h.update((objects.len() as u64).to_le_bytes());
     for m in objects {
         h.update((m.vertices.len() as u64).to_le_bytes());

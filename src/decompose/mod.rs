@@ -4,7 +4,9 @@
 //! [`finish`]: at most `max_hulls` hulls per object, at most `max_vertices` vertices per hull,
 //! no degenerate or paper-thin hulls. Every engine's hulls then go through [`physx_legal`]: at
 //! most `max_polygons` polygons per hull (PhysX re-cooks a hull over 64 polygons into another
-//! shape, silently), no slivers PhysX keeps off the GPU.
+//! shape, silently), no slivers PhysX keeps off the GPU, every vertex bulging past PhysX's
+//! plane tolerance but those an object's pieces share. With a polygon budget, engines are
+//! called with [`DecomposeOptions::engine_budget`], so their hulls are within it as built.
 
 pub mod cache;
 mod hull;
@@ -20,10 +22,10 @@ use crate::mesh::Mesh;
 pub const DEFAULT_MAX_HULLS: usize = 32;
 
 /// PhysX's polygon budget per hull: it re-cooks a hull of more polygons into another shape,
-/// silently (`--max-hull-polygons 64` keeps every hull within it). Not the default: bringing
-/// the scene-aware hulls within it by dropping vertices cost +1.6 points of p95 on average over
-/// the 43 shared objects and up to +13 on round solids (docs/usd.md), so it is asked for by
-/// those who export for Isaac.
+/// silently (`--max-hull-polygons 64` keeps every hull within it). Not the default: with the
+/// budget in the engine ([`DecomposeOptions::engine_budget`]) it costs +0.08 points of
+/// two-sided p95 on average over the 43 shared objects, but up to +1.1 on small round solids
+/// (docs/usd.md), so it is asked for by those who export for Isaac.
 pub const PHYSX_MAX_POLYGONS: usize = 64;
 
 /// Hulls whose [`Hull::sliver_ratio`] is above this are dropped by [`physx_legal`] (unless they
@@ -69,6 +71,32 @@ impl Default for DecomposeOptions {
             clearance: 1e-4,
             cache_dir: None,
         }
+    }
+}
+
+impl DecomposeOptions {
+    /// The options an engine builds hulls with so that they are within the polygon budget by
+    /// construction: with `max_polygons` set, at most `max_polygons / 2 + 2` vertices per hull.
+    /// A convex polyhedron of `V` vertices triangulates into exactly `2V − 4` triangles (Euler),
+    /// and merging coplanar ones only lowers the count, so such a hull never has more than
+    /// `max_polygons` polygons, whatever its shape (34 vertices for PhysX's 64; PhysX's own
+    /// re-cooking of round hulls also lands on 34). The engine's quality loop then measures
+    /// the hulls it will ship and splits where they deviate, instead of [`physx_legal`]
+    /// shrinking them after the fact (docs/usd.md has the cost of both). Without a polygon
+    /// budget the options are unchanged.
+    pub fn engine_budget(&self) -> DecomposeOptions {
+        let mut o = self.clone();
+        if self.max_polygons != usize::MAX {
+            o.max_vertices = self.max_vertices.min(self.max_polygons / 2 + 2).max(4);
+        }
+        o
+    }
+
+    /// PhysX's plane tolerance, with margin ([`PHYSX_PLANE_TOLERANCE`]), when hulls are built
+    /// for it (a polygon budget is set): every hull vertex must bulge out of the hull of the
+    /// others by more, or PhysX's cooking skips it. `None` without a polygon budget.
+    pub fn plane_tolerance(&self) -> Option<f64> {
+        (self.max_polygons != usize::MAX).then_some(PHYSX_PLANE_TOLERANCE)
     }
 }
 
@@ -181,12 +209,18 @@ pub fn physx_legal(sets: &mut [Vec<Hull>], opts: &DecomposeOptions) -> Vec<Legal
     sets.iter_mut()
         .map(|hulls| {
             let (mut reduced, mut over) = (0, 0);
+            let seams = seam_vertices(hulls);
+            let pinned = |p: &crate::mesh::P3| {
+                seams
+                    .binary_search_by(|q| key_of(q).cmp(&key_of(p)))
+                    .is_ok()
+            };
             let mut out = Vec::with_capacity(hulls.len());
             for h in hulls.drain(..) {
                 let before = h.vertices.len();
                 let fallback = h.clone();
                 let h = match h
-                    .within(&limits)
+                    .within_pinned(&limits, &pinned)
                     .filter(|h| h.thickness() >= opts.min_thickness)
                 {
                     Some(h) => h,
@@ -224,4 +258,113 @@ pub fn physx_legal(sets: &mut [Vec<Hull>], opts: &DecomposeOptions) -> Vec<Legal
             }
         })
         .collect()
+}
+
+/// A point's coordinates as bits, to compare points exactly.
+fn key_of(p: &crate::mesh::P3) -> [u64; 3] {
+    [p.x.to_bits(), p.y.to_bits(), p.z.to_bits()]
+}
+
+/// The vertices (exactly equal coordinates) that two or more of `hulls` share, sorted by
+/// [`key_of`]: the seams where an object's pieces meet.
+fn seam_vertices(hulls: &[Hull]) -> Vec<crate::mesh::P3> {
+    let mut all: Vec<([u64; 3], usize)> = hulls
+        .iter()
+        .enumerate()
+        .flat_map(|(k, h)| h.vertices.iter().map(move |v| (key_of(v), k)))
+        .collect();
+    all.sort_unstable();
+    all.dedup();
+    let mut out: Vec<crate::mesh::P3> = Vec::new();
+    for w in all.windows(2) {
+        if w[0].0 == w[1].0 && out.last().is_none_or(|q| key_of(q) != w[0].0) {
+            out.push(crate::mesh::P3::new(
+                f64::from_bits(w[0].0[0]),
+                f64::from_bits(w[0].0[1]),
+                f64::from_bits(w[0].0[2]),
+            ));
+        }
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::mesh::P3;
+    use crate::shapes;
+
+    #[test]
+    fn engine_budget_bounds_polygons_by_euler() {
+        let o = DecomposeOptions {
+            max_polygons: PHYSX_MAX_POLYGONS,
+            ..Default::default()
+        };
+        assert_eq!(o.engine_budget().max_vertices, 34);
+        assert_eq!(o.plane_tolerance(), Some(PHYSX_PLANE_TOLERANCE));
+        // Without a polygon budget nothing changes.
+        let free = DecomposeOptions::default();
+        assert_eq!(free.engine_budget(), free);
+        assert_eq!(free.plane_tolerance(), None);
+        // A round hull of 34 vertices (no two faces coplanar) has exactly 2·34 − 4 = 64 faces:
+        // the most polygons a 34-vertex hull can have.
+        let h = Hull::from_points(&shapes::uv_sphere(0.05, 24, 48).vertices)
+            .unwrap()
+            .simplified(34)
+            .unwrap();
+        assert_eq!(h.vertices.len(), 34);
+        assert_eq!(h.triangles.len(), 64);
+        assert!(h.polygon_stats().0 <= 64);
+    }
+
+    #[test]
+    fn physx_legal_keeps_the_seams_between_pieces() {
+        // Two halves of a 2 cm ball, cut by the plane x = 0: they share the ring on the cut.
+        // Its vertices are about 3 mm apart and bulge about s²/2R = 0.5 mm, less than PhysX's
+        // plane tolerance: dropping them from a cap is allowed, but the shared ring must stay
+        // in both halves, or a gap opens between them.
+        let s = shapes::uv_sphere(0.01, 10, 20);
+        let mut left: Vec<P3> = vec![P3::origin()];
+        let mut right: Vec<P3> = vec![P3::origin()];
+        for v in &s.vertices {
+            if v.x <= 1e-12 {
+                left.push(*v);
+            }
+            if v.x >= -1e-12 {
+                right.push(*v);
+            }
+        }
+        let mut sets = vec![vec![
+            Hull::from_points(&left).unwrap(),
+            Hull::from_points(&right).unwrap(),
+        ]];
+        let seam: Vec<P3> = sets[0][0]
+            .vertices
+            .iter()
+            .filter(|v| sets[0][1].vertices.contains(v))
+            .copied()
+            .collect();
+        assert!(seam.len() >= 10, "{}", seam.len());
+        let before: Vec<usize> = sets[0].iter().map(|h| h.vertices.len()).collect();
+        let o = DecomposeOptions {
+            max_polygons: PHYSX_MAX_POLYGONS,
+            ..Default::default()
+        };
+        let notes = physx_legal(&mut sets, &o);
+        assert_eq!(notes[0].over, 0);
+        for (h, n) in sets[0].iter().zip(before) {
+            assert!(h.vertices.len() < n, "insignificant cap vertices dropped");
+            for v in &seam {
+                assert!(h.vertices.contains(v), "seam vertex {v:?} kept");
+            }
+            let (p, pv) = h.polygon_stats();
+            assert!(h.vertices.len() <= 64 && p <= 64 && pv <= 32, "{p} {pv}");
+        }
+        // Without the seams kept, each half alone loses seam vertices.
+        let alone = Hull::from_points(&left)
+            .unwrap()
+            .within(&PhysxLimits::default())
+            .unwrap();
+        assert!(seam.iter().any(|v| !alone.vertices.contains(v)));
+    }
 }
