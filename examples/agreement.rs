@@ -1,14 +1,18 @@
 //! Cross-engine rest agreement over generated scenes (issue #33): random item-in/on-support,
 //! item-on-item and item-on-floor scenes from `../shared/datasets/objects`, settled in Rapier and
-//! exported by the library, then replayed in MuJoCo (`tests/python/agreement_mujoco.py`).
-//! Prints one line per disagreeing scene and a summary table; writes OUT/scenes.jsonl (every
-//! scene, both engines) and OUT/summary.json.
+//! exported by the library, then replayed in MuJoCo (`tests/python/agreement_mujoco.py`) and,
+//! with `--physx`, in PhysX as well (`tests/python/agreement_physx.py`, on the USD export).
+//! Prints one line per disagreeing scene and a summary table per engine; writes
+//! OUT/scenes.jsonl and OUT/summary.json (MuJoCo), OUT/scenes_physx.jsonl and
+//! OUT/summary_physx.json (PhysX).
 //!
 //! Run: `nice cargo run --release --example agreement -- [--seeds 0..300] [--out DIR]
-//!       [--objects DIR] [--batch 10] [--keep]` (the judge's interpreter: `INTERACT3D_PYTHON`,
-//! default `python3`). Objects are decomposed once each and cached in `target/agreement-cache`.
+//!       [--objects DIR] [--batch 10] [--keep] [--physx] [--physx-every K]` (`--physx-every K`:
+//! PhysX judges one batch in K, it is about 4x slower than MuJoCo; the judges' interpreter:
+//! `INTERACT3D_PYTHON`, default `python3`). Objects are decomposed once each and cached in
+//! `target/agreement-cache`.
 
-use interact3d::agreement::{judge, run_scene, summary, Catalog, Judged};
+use interact3d::agreement::{judge, run_scene, summary, Catalog, Judged, Summary};
 use rayon::prelude::*;
 use std::io::Write;
 use std::path::PathBuf;
@@ -19,6 +23,8 @@ fn main() {
     let mut objects = PathBuf::from("../shared/datasets/objects");
     let mut batch = 10usize;
     let mut keep = false;
+    let mut physx = false;
+    let mut physx_every = 1usize;
     let mut args = std::env::args().skip(1);
     while let Some(a) = args.next() {
         match a.as_str() {
@@ -31,6 +37,11 @@ fn main() {
             "--objects" => objects = args.next().expect("--objects DIR").into(),
             "--batch" => batch = args.next().expect("--batch N").parse().expect("N"),
             "--keep" => keep = true,
+            "--physx" => physx = true,
+            "--physx-every" => {
+                physx = true;
+                physx_every = args.next().expect("--physx-every K").parse().expect("K");
+            }
             _ => {
                 eprintln!("unknown argument {a}");
                 std::process::exit(2);
@@ -38,7 +49,9 @@ fn main() {
         }
     }
     let python = std::env::var("INTERACT3D_PYTHON").unwrap_or_else(|_| "python3".into());
-    let script = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/python/agreement_mujoco.py");
+    let scripts = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/python");
+    let script = scripts.join("agreement_mujoco.py");
+    let physx_script = scripts.join("agreement_physx.py");
     std::fs::create_dir_all(&out).expect("output folder");
     let t = std::time::Instant::now();
     let catalog = Catalog::load(&objects, None, Some("target/agreement-cache".into()))
@@ -52,9 +65,13 @@ fn main() {
         t.elapsed().as_secs_f64()
     );
     let mut lines = std::fs::File::create(out.join("scenes.jsonl")).expect("scenes.jsonl");
+    let mut px_lines = physx.then(|| {
+        std::fs::File::create(out.join("scenes_physx.jsonl")).expect("scenes_physx.jsonl")
+    });
     let mut all: Vec<Judged> = Vec::new();
+    let mut all_px: Vec<Judged> = Vec::new();
     let seed_list: Vec<u64> = seeds.clone().collect();
-    for chunk in seed_list.chunks(batch) {
+    for (k, chunk) in seed_list.chunks(batch).enumerate() {
         let done: Vec<_> = chunk
             .par_iter()
             .filter_map(|&seed| {
@@ -69,18 +86,9 @@ fn main() {
                 }
             })
             .collect();
-        let judged = judge(&python, &script, &done).unwrap_or_else(|e| {
-            eprintln!("{e}");
-            std::process::exit(1)
-        });
-        for j in &judged {
-            writeln!(lines, "{}", serde_json::to_string(j).unwrap()).unwrap();
-            if let Some(c) = interact3d::agreement::judge::cause(j) {
-                eprintln!(
-                    "seed {} {:?}: {c}; drifts {:?}",
-                    j.seed, j.objects, j.rest_drifts
-                );
-            }
+        let judged = judged_by("MuJoCo", &python, &script, &done, &mut lines);
+        if let Some(px) = px_lines.as_mut().filter(|_| k % physx_every == 0) {
+            all_px.extend(judged_by("PhysX", &python, &physx_script, &done, px));
         }
         if !keep {
             for (_, _, d) in &done {
@@ -96,11 +104,53 @@ fn main() {
         serde_json::to_string_pretty(&s).unwrap(),
     )
     .unwrap();
+    print_table("MuJoCo", &seeds, &s);
+    if physx {
+        let s = summary(&all_px);
+        std::fs::write(
+            out.join("summary_physx.json"),
+            serde_json::to_string_pretty(&s).unwrap(),
+        )
+        .unwrap();
+        let seeds: Vec<u64> = all_px.iter().map(|j| j.seed).collect();
+        println!("\nPhysX judged seeds: {seeds:?}");
+        print_table("PhysX", &(0..0), &s);
+    }
+}
+
+/// Judge a batch with one engine, write its lines, print its disagreements.
+fn judged_by(
+    engine: &str,
+    python: &str,
+    script: &std::path::Path,
+    done: &[(interact3d::agreement::Generated, interact3d::agreement::Ours, PathBuf)],
+    lines: &mut std::fs::File,
+) -> Vec<Judged> {
+    let judged = judge(engine, python, script, done).unwrap_or_else(|e| {
+        eprintln!("{e}");
+        std::process::exit(1)
+    });
+    for j in &judged {
+        writeln!(lines, "{}", serde_json::to_string(j).unwrap()).unwrap();
+        if let Some(c) = interact3d::agreement::judge::cause(j) {
+            eprintln!(
+                "seed {} {:?}: {c}; drifts {:?}",
+                j.seed, j.objects, j.rest_drifts
+            );
+        }
+    }
+    judged
+}
+
+fn print_table(engine: &str, seeds: &std::ops::Range<u64>, s: &Summary) {
     let pct = |a: usize, n: usize| 100.0 * a as f64 / n.max(1) as f64;
-    println!("seeds {}..{} ({} scenes)", seeds.start, seeds.end, s.scenes);
+    if !seeds.is_empty() {
+        println!("seeds {}..{}", seeds.start, seeds.end);
+    }
+    println!("{engine}: {} scenes", s.scenes);
     println!("{:<44} {:>8}", "", "count");
     println!("{:<44} {:>8}", "we pass", s.we_pass);
-    println!("{:<44} {:>8}", "MuJoCo passes", s.mujoco_pass);
+    println!("{:<44} {:>8}", format!("{engine} passes"), s.mujoco_pass);
     println!(
         "{:<44} {:>8}  ({:.1} %)",
         "verdict agrees",
@@ -119,7 +169,7 @@ fn main() {
         println!("  {c:<70} {n:>4}");
     }
     println!(
-        "MuJoCo drift of bodies at rest: mean {:.3} mm / {:.3} deg, worst {:.3} mm / {:.3} deg",
+        "{engine} drift of bodies at rest: mean {:.3} mm / {:.3} deg, worst {:.3} mm / {:.3} deg",
         s.drift_mean_mm, s.drift_mean_deg, s.drift_worst_mm, s.drift_worst_deg
     );
     println!(

@@ -33,7 +33,7 @@ fn generated_scenes_agree_with_mujoco() {
         .collect();
     let python = common::python();
     let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/python/agreement_mujoco.py");
-    let judged = judge(&python, &script, &scenes).unwrap();
+    let judged = judge("MuJoCo", &python, &script, &scenes).unwrap();
     let passed = judged.iter().filter(|j| j.ours.passed).count();
     assert!(
         passed >= 3,

@@ -1,11 +1,12 @@
 //! The other engine's side: `tests/python/agreement_mujoco.py` replays every exported scene in
-//! MuJoCo (one process for a batch) and this module compares its answers with ours.
+//! MuJoCo (`scene.xml`), `tests/python/agreement_physx.py` in PhysX (`scene.usda`, ovphysx on
+//! the CPU), one process for a batch, and this module compares their answers with ours.
 //!
-//! MuJoCo's scene verdict ([`RULES`]) is the settle test's rule replayed from the `composed`
-//! keyframe: after 2 s every free body's centre of mass has moved at most 10 % of its
-//! bounding-box diagonal, and over the next 1 s it moves at most 1 mm and turns at most 1°.
-//! MuJoCo's rest answer: from the `settled` keyframe (the exported pose), every body stays
-//! within 1 mm and 1° for 2 s.
+//! The engine's scene verdict ([`RULES`]) is the settle test's rule replayed from the composed
+//! pose (MJCF keyframe `composed`; the USD's `customData` composed pose): after 2 s every free
+//! body's centre of mass has moved at most 10 % of its bounding-box diagonal, and over the next
+//! 1 s it moves at most 1 mm and turns at most 1°. The engine's rest answer: from the exported
+//! (settled) pose, every body stays within 1 mm and 1° for 2 s.
 
 use super::{Generated, Ours};
 use crate::error::{Error, Result};
@@ -13,13 +14,13 @@ use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
-/// MuJoCo's verdict rule, as written into the results.
+/// The engine's verdict rule, as written into the results.
 pub const RULES: &str = "from the composed pose: COM drift <= 10% of the bbox diagonal after 2 s, then <= 1 mm and <= 1 deg over 1 s; rest: <= 1 mm and <= 1 deg for 2 s from the settled pose";
 /// Rest agreement thresholds.
 pub const REST_MM: f64 = 1.0;
 pub const REST_DEG: f64 = 1.0;
 
-/// What MuJoCo reported on one body.
+/// What the engine reported on one body.
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct MjBody {
     /// Composed-pose run: COM drift after the settle part (m), then the rest part's worst
@@ -32,7 +33,7 @@ pub struct MjBody {
     pub from_settled_deg: f64,
 }
 
-/// What MuJoCo reported on one scene.
+/// What the engine reported on one scene.
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct MjScene {
     pub dir: PathBuf,
@@ -45,6 +46,8 @@ pub struct MjScene {
 /// One scene, both engines.
 #[derive(Clone, Debug, Serialize)]
 pub struct Judged {
+    /// The other engine's name (`MuJoCo`, `PhysX`).
+    pub engine: String,
     pub seed: u64,
     pub kind: super::Kind,
     pub objects: Vec<String>,
@@ -54,14 +57,16 @@ pub struct Judged {
     pub verdict_agrees: bool,
     /// `None` when we fail the scene (no rest pose claimed).
     pub rest_agrees: Option<bool>,
-    /// Bodies we call at rest that MuJoCo moves past 1 mm / 1° (name, mm, degrees).
+    /// Bodies we call at rest that the engine moves past 1 mm / 1° (name, mm, degrees).
     pub rest_drifts: Vec<(String, f64, f64)>,
     /// Our own honesty flag: the scene had a body our probe calls marginal.
     pub marginal: bool,
 }
 
-/// Run the MuJoCo judge on exported scenes (`dirs[i]` holds the export of `scenes[i]`).
+/// Run a judge script (`engine` names it in causes) on exported scenes (`scenes[i].2` holds
+/// the export of `scenes[i].0`).
 pub fn judge(
+    engine: &str,
     python: &str,
     script: &Path,
     scenes: &[(Generated, Ours, PathBuf)],
@@ -115,11 +120,11 @@ pub fn judge(
     Ok(scenes
         .iter()
         .zip(results)
-        .map(|((g, ours, _), mj)| compare(g, ours, mj))
+        .map(|((g, ours, _), mj)| compare(engine, g, ours, mj))
         .collect())
 }
 
-fn compare(g: &Generated, ours: &Ours, mj: MjScene) -> Judged {
+fn compare(engine: &str, g: &Generated, ours: &Ours, mj: MjScene) -> Judged {
     let mut rest_drifts = Vec::new();
     if ours.passed {
         // A marginal body is not claimed to be at rest (it is reported as marginal instead).
@@ -133,6 +138,7 @@ fn compare(g: &Generated, ours: &Ours, mj: MjScene) -> Judged {
         }
     }
     Judged {
+        engine: engine.to_string(),
         seed: g.seed,
         kind: g.kind,
         objects: g.objects.clone(),
@@ -179,7 +185,8 @@ pub fn cause(j: &Judged) -> Option<String> {
                 .map(|(n, b)| (n, b.rest_m.max(b.settle_m)))
                 .max_by(|a, b| a.1.total_cmp(&b.1));
             format!(
-                "verdict: we pass, MuJoCo fails ({:?}; {})",
+                "verdict: we pass, {} fails ({:?}; {})",
+                j.engine,
                 j.kind,
                 worst.map(|w| w.0.as_str()).unwrap_or("?")
             )
@@ -198,12 +205,15 @@ pub fn cause(j: &Judged) -> Option<String> {
                         .collect()
                 })
                 .unwrap_or_default();
-            format!("verdict: we fail, MuJoCo passes ({:?}; {first})", j.kind)
+            format!(
+                "verdict: we fail, {} passes ({:?}; {first})",
+                j.engine, j.kind
+            )
         });
     }
     if j.rest_agrees == Some(false) {
         let (name, _, _) = &j.rest_drifts[0];
-        return Some(format!("rest: {name} moves in MuJoCo ({:?})", j.kind));
+        return Some(format!("rest: {name} moves in {} ({:?})", j.engine, j.kind));
     }
     None
 }
