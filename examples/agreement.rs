@@ -7,12 +7,15 @@
 //! OUT/summary_physx.json (PhysX).
 //!
 //! Run: `nice cargo run --release --example agreement -- [--seeds 0..300] [--out DIR]
-//!       [--objects DIR] [--batch 10] [--keep] [--physx] [--physx-every K]` (`--physx-every K`:
+//!       [--objects DIR] [--batch 10] [--keep] [--physx] [--physx-every K] [--only S1,S2]
+//!       [--set KEY=VALUE]` (`--only`: these seeds instead; `--set`: a settle option, for
+//! experiments; `--physx-every K`:
 //! PhysX judges one batch in K, it is about 4x slower than MuJoCo; the judges' interpreter:
 //! `INTERACT3D_PYTHON`, default `python3`). Objects are decomposed once each and cached in
 //! `target/agreement-cache`.
 
-use interact3d::agreement::{judge, run_scene, summary, Catalog, Judged, Summary};
+use interact3d::agreement::{judge, run_scene_with, summary, Catalog, Judged, Summary};
+use interact3d::physics::SettleOptions;
 use rayon::prelude::*;
 use std::io::Write;
 use std::path::PathBuf;
@@ -25,6 +28,8 @@ fn main() {
     let mut keep = false;
     let mut physx = false;
     let mut physx_every = 1usize;
+    let mut only: Option<Vec<u64>> = None;
+    let mut settle = SettleOptions::default();
     let mut args = std::env::args().skip(1);
     while let Some(a) = args.next() {
         match a.as_str() {
@@ -37,6 +42,11 @@ fn main() {
             "--objects" => objects = args.next().expect("--objects DIR").into(),
             "--batch" => batch = args.next().expect("--batch N").parse().expect("N"),
             "--keep" => keep = true,
+            "--only" => {
+                let v = args.next().expect("--only S1,S2,...");
+                only = Some(v.split(',').map(|s| s.parse().expect("seed")).collect());
+            }
+            "--set" => set(&mut settle, &args.next().expect("--set KEY=VALUE")),
             "--physx" => physx = true,
             "--physx-every" => {
                 physx = true;
@@ -70,14 +80,14 @@ fn main() {
     });
     let mut all: Vec<Judged> = Vec::new();
     let mut all_px: Vec<Judged> = Vec::new();
-    let seed_list: Vec<u64> = seeds.clone().collect();
+    let seed_list: Vec<u64> = only.clone().unwrap_or_else(|| seeds.clone().collect());
     for (k, chunk) in seed_list.chunks(batch).enumerate() {
         let done: Vec<_> = chunk
             .par_iter()
             .filter_map(|&seed| {
                 let g = catalog.compose(seed);
                 let dir = out.join(format!("scene_{seed}"));
-                match run_scene(&g, &dir) {
+                match run_scene_with(&g, &dir, &settle) {
                     Ok(ours) => Some((g, ours, dir)),
                     Err(e) => {
                         eprintln!("seed {seed}: {e}");
@@ -104,7 +114,10 @@ fn main() {
         serde_json::to_string_pretty(&s).unwrap(),
     )
     .unwrap();
-    print_table("MuJoCo", &seeds, &s);
+    if let Some(o) = &only {
+        println!("seeds {o:?}");
+    }
+    print_table("MuJoCo", &(if only.is_some() { 0..0 } else { seeds }), &s);
     if physx {
         let s = summary(&all_px);
         std::fs::write(
@@ -115,6 +128,32 @@ fn main() {
         let seeds: Vec<u64> = all_px.iter().map(|j| j.seed).collect();
         println!("\nPhysX judged seeds: {seeds:?}");
         print_table("PhysX", &(0..0), &s);
+    }
+}
+
+/// `--set KEY=VALUE`: a settle option (experiments; the defaults are the library's).
+fn set(o: &mut SettleOptions, kv: &str) {
+    let (k, v) = kv.split_once('=').expect("--set KEY=VALUE");
+    let x: f64 = v.parse().expect("a number");
+    match k {
+        "dt" => o.dt = x,
+        "solver_iterations" => o.solver_iterations = x as usize,
+        "settle_max_time" => o.settle_max_time = x,
+        "rest_time" => o.rest_time = x,
+        "sleep_linear_threshold" => o.sleep_linear_threshold = x,
+        "sleep_time" => o.sleep_time = x,
+        "contact_frequency" => o.contact_frequency = x,
+        "static_contact_frequency" => o.static_contact_frequency = x,
+        "angular_damping" => o.angular_damping = x,
+        "prediction_distance" => o.prediction_distance = x,
+        "contact_recycling" => o.contact_recycling = x != 0.0,
+        "contact_recycle_distance" => o.contact_recycle_distance = x,
+        "probe_angle_deg" => o.probe_angle_deg = x,
+        "probe_time" => o.probe_time = x,
+        _ => {
+            eprintln!("--set: unknown settle option {k}");
+            std::process::exit(2)
+        }
     }
 }
 
@@ -165,6 +204,14 @@ fn print_table(engine: &str, seeds: &std::ops::Range<u64>, s: &Summary) {
         s.rest_judged
     );
     println!("{:<44} {:>8}", "scenes with a marginal body", s.marginal);
+    println!(
+        "{:<44} {:>8}  (of {} marginal bodies; {} of {} other bodies)",
+        format!("marginal bodies {engine} moves"),
+        s.marginal_bodies_moved,
+        s.marginal_bodies,
+        s.stable_bodies_moved,
+        s.stable_bodies
+    );
     for (c, n) in &s.causes {
         println!("  {c:<70} {n:>4}");
     }

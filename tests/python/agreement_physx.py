@@ -8,7 +8,8 @@ Same input and output as agreement_mujoco.py (one JSON line per scene on stdout)
   object prim, written into a copy of scene.usda beside it): simulate 2 s (settle), then 1 s
   (rest). A free body passes when its centre of mass moved at most 10 % of its bounding-box
   diagonal over the settle part and at most 1 mm / 1 degree over the rest part; the scene passes
-  when all do;
+  when all do; the turn over the settle part is reported (settle_deg, settle_q0, settle_q1 as
+  w, x, y, z) for the caller's large-turn rule;
 - from scene.usda as exported (the settled pose): the worst displacement and turn of each body
   over 2 s.
 Poses are PhysX's rigid-body poses, read every step (the export puts the body frame at the
@@ -47,6 +48,11 @@ def stdout_to_stderr():
 def angle_deg(q0, q1):
     d = abs(float(np.dot(q0, q1)) / (np.linalg.norm(q0) * np.linalg.norm(q1)))
     return math.degrees(2.0 * math.acos(min(1.0, d)))
+
+
+def wxyz(q):
+    """PhysX orientations are (x, y, z, w)."""
+    return [float(q[3]), float(q[0]), float(q[1]), float(q[2])]
 
 
 def composed_copy(scene_dir):
@@ -152,7 +158,15 @@ def judge(entry):
         n = names[p]
         ok = settle[p] <= 0.10 * diag.get(n, float("inf")) and rest[p][0] <= 1e-3 and rest[p][1] <= 1.0
         passed = passed and ok
-        out[n] = {"settle_m": settle[p], "rest_m": rest[p][0], "rest_deg": rest[p][1]}
+        q0, q1 = wxyz(composed[p][1]), wxyz(after[p][1])
+        out[n] = {
+            "settle_m": settle[p],
+            "settle_deg": angle_deg(q0, q1),
+            "settle_q0": q0,
+            "settle_q1": q1,
+            "rest_m": rest[p][0],
+            "rest_deg": rest[p][1],
+        }
 
     r = Run(os.path.join(d, "scene.usda"))
     start = dynamic_only(r.poses(), names)
