@@ -162,7 +162,11 @@ fn judged_by(
     engine: &str,
     python: &str,
     script: &std::path::Path,
-    done: &[(interact3d::agreement::Generated, interact3d::agreement::Ours, PathBuf)],
+    done: &[(
+        interact3d::agreement::Generated,
+        interact3d::agreement::Ours,
+        PathBuf,
+    )],
     lines: &mut std::fs::File,
 ) -> Vec<Judged> {
     let judged = judge(engine, python, script, done).unwrap_or_else(|e| {

@@ -36,9 +36,9 @@ mod settle;
 mod world;
 
 pub use settle::{settle, simulate};
-pub use world::{rapier_mass_properties, shape_shift};
 #[cfg(test)]
 use world::Sim;
+pub use world::{rapier_mass_properties, shape_shift};
 
 /// Name used for the floor in support lists and reasons.
 pub const FLOOR: &str = "floor";
