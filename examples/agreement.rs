@@ -1,14 +1,21 @@
 //! Cross-engine rest agreement over generated scenes (issue #33): random item-in/on-support,
 //! item-on-item and item-on-floor scenes from `../shared/datasets/objects`, settled in Rapier and
-//! exported by the library, then replayed in MuJoCo (`tests/python/agreement_mujoco.py`).
-//! Prints one line per disagreeing scene and a summary table; writes OUT/scenes.jsonl (every
-//! scene, both engines) and OUT/summary.json.
+//! exported by the library, then replayed in MuJoCo (`tests/python/agreement_mujoco.py`) and,
+//! with `--physx`, in PhysX as well (`tests/python/agreement_physx.py`, on the USD export).
+//! Prints one line per disagreeing scene and a summary table per engine; writes
+//! OUT/scenes.jsonl and OUT/summary.json (MuJoCo), OUT/scenes_physx.jsonl and
+//! OUT/summary_physx.json (PhysX).
 //!
 //! Run: `nice cargo run --release --example agreement -- [--seeds 0..300] [--out DIR]
-//!       [--objects DIR] [--batch 10] [--keep]` (the judge's interpreter: `INTERACT3D_PYTHON`,
-//! default `python3`). Objects are decomposed once each and cached in `target/agreement-cache`.
+//!       [--objects DIR] [--batch 10] [--keep] [--physx] [--physx-every K] [--only S1,S2]
+//!       [--set KEY=VALUE]` (`--only`: these seeds instead; `--set`: a settle option, for
+//! experiments; `--physx-every K`:
+//! PhysX judges one batch in K, it is about 4x slower than MuJoCo; the judges' interpreter:
+//! `INTERACT3D_PYTHON`, default `python3`). Objects are decomposed once each and cached in
+//! `target/agreement-cache`.
 
-use interact3d::agreement::{judge, run_scene, summary, Catalog, Judged};
+use interact3d::agreement::{judge, run_scene_with, summary, Catalog, Judged, Summary};
+use interact3d::physics::SettleOptions;
 use rayon::prelude::*;
 use std::io::Write;
 use std::path::PathBuf;
@@ -19,6 +26,10 @@ fn main() {
     let mut objects = PathBuf::from("../shared/datasets/objects");
     let mut batch = 10usize;
     let mut keep = false;
+    let mut physx = false;
+    let mut physx_every = 1usize;
+    let mut only: Option<Vec<u64>> = None;
+    let mut settle = SettleOptions::default();
     let mut args = std::env::args().skip(1);
     while let Some(a) = args.next() {
         match a.as_str() {
@@ -31,6 +42,16 @@ fn main() {
             "--objects" => objects = args.next().expect("--objects DIR").into(),
             "--batch" => batch = args.next().expect("--batch N").parse().expect("N"),
             "--keep" => keep = true,
+            "--only" => {
+                let v = args.next().expect("--only S1,S2,...");
+                only = Some(v.split(',').map(|s| s.parse().expect("seed")).collect());
+            }
+            "--set" => set(&mut settle, &args.next().expect("--set KEY=VALUE")),
+            "--physx" => physx = true,
+            "--physx-every" => {
+                physx = true;
+                physx_every = args.next().expect("--physx-every K").parse().expect("K");
+            }
             _ => {
                 eprintln!("unknown argument {a}");
                 std::process::exit(2);
@@ -38,7 +59,9 @@ fn main() {
         }
     }
     let python = std::env::var("INTERACT3D_PYTHON").unwrap_or_else(|_| "python3".into());
-    let script = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/python/agreement_mujoco.py");
+    let scripts = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/python");
+    let script = scripts.join("agreement_mujoco.py");
+    let physx_script = scripts.join("agreement_physx.py");
     std::fs::create_dir_all(&out).expect("output folder");
     let t = std::time::Instant::now();
     let catalog = Catalog::load(&objects, None, Some("target/agreement-cache".into()))
@@ -52,15 +75,19 @@ fn main() {
         t.elapsed().as_secs_f64()
     );
     let mut lines = std::fs::File::create(out.join("scenes.jsonl")).expect("scenes.jsonl");
+    let mut px_lines = physx.then(|| {
+        std::fs::File::create(out.join("scenes_physx.jsonl")).expect("scenes_physx.jsonl")
+    });
     let mut all: Vec<Judged> = Vec::new();
-    let seed_list: Vec<u64> = seeds.clone().collect();
-    for chunk in seed_list.chunks(batch) {
+    let mut all_px: Vec<Judged> = Vec::new();
+    let seed_list: Vec<u64> = only.clone().unwrap_or_else(|| seeds.clone().collect());
+    for (k, chunk) in seed_list.chunks(batch).enumerate() {
         let done: Vec<_> = chunk
             .par_iter()
             .filter_map(|&seed| {
                 let g = catalog.compose(seed);
                 let dir = out.join(format!("scene_{seed}"));
-                match run_scene(&g, &dir) {
+                match run_scene_with(&g, &dir, &settle) {
                     Ok(ours) => Some((g, ours, dir)),
                     Err(e) => {
                         eprintln!("seed {seed}: {e}");
@@ -69,18 +96,9 @@ fn main() {
                 }
             })
             .collect();
-        let judged = judge(&python, &script, &done).unwrap_or_else(|e| {
-            eprintln!("{e}");
-            std::process::exit(1)
-        });
-        for j in &judged {
-            writeln!(lines, "{}", serde_json::to_string(j).unwrap()).unwrap();
-            if let Some(c) = interact3d::agreement::judge::cause(j) {
-                eprintln!(
-                    "seed {} {:?}: {c}; drifts {:?}",
-                    j.seed, j.objects, j.rest_drifts
-                );
-            }
+        let judged = judged_by("MuJoCo", &python, &script, &done, &mut lines);
+        if let Some(px) = px_lines.as_mut().filter(|_| k % physx_every == 0) {
+            all_px.extend(judged_by("PhysX", &python, &physx_script, &done, px));
         }
         if !keep {
             for (_, _, d) in &done {
@@ -96,11 +114,86 @@ fn main() {
         serde_json::to_string_pretty(&s).unwrap(),
     )
     .unwrap();
+    if let Some(o) = &only {
+        println!("seeds {o:?}");
+    }
+    print_table("MuJoCo", &(if only.is_some() { 0..0 } else { seeds }), &s);
+    if physx {
+        let s = summary(&all_px);
+        std::fs::write(
+            out.join("summary_physx.json"),
+            serde_json::to_string_pretty(&s).unwrap(),
+        )
+        .unwrap();
+        let seeds: Vec<u64> = all_px.iter().map(|j| j.seed).collect();
+        println!("\nPhysX judged seeds: {seeds:?}");
+        print_table("PhysX", &(0..0), &s);
+    }
+}
+
+/// `--set KEY=VALUE`: a settle option (experiments; the defaults are the library's).
+fn set(o: &mut SettleOptions, kv: &str) {
+    let (k, v) = kv.split_once('=').expect("--set KEY=VALUE");
+    let x: f64 = v.parse().expect("a number");
+    match k {
+        "dt" => o.dt = x,
+        "solver_iterations" => o.solver_iterations = x as usize,
+        "settle_max_time" => o.settle_max_time = x,
+        "rest_time" => o.rest_time = x,
+        "sleep_linear_threshold" => o.sleep_linear_threshold = x,
+        "sleep_time" => o.sleep_time = x,
+        "contact_frequency" => o.contact_frequency = x,
+        "static_contact_frequency" => o.static_contact_frequency = x,
+        "angular_damping" => o.angular_damping = x,
+        "prediction_distance" => o.prediction_distance = x,
+        "contact_recycling" => o.contact_recycling = x != 0.0,
+        "contact_recycle_distance" => o.contact_recycle_distance = x,
+        "probe_angle_deg" => o.probe_angle_deg = x,
+        "probe_time" => o.probe_time = x,
+        _ => {
+            eprintln!("--set: unknown settle option {k}");
+            std::process::exit(2)
+        }
+    }
+}
+
+/// Judge a batch with one engine, write its lines, print its disagreements.
+fn judged_by(
+    engine: &str,
+    python: &str,
+    script: &std::path::Path,
+    done: &[(
+        interact3d::agreement::Generated,
+        interact3d::agreement::Ours,
+        PathBuf,
+    )],
+    lines: &mut std::fs::File,
+) -> Vec<Judged> {
+    let judged = judge(engine, python, script, done).unwrap_or_else(|e| {
+        eprintln!("{e}");
+        std::process::exit(1)
+    });
+    for j in &judged {
+        writeln!(lines, "{}", serde_json::to_string(j).unwrap()).unwrap();
+        if let Some(c) = interact3d::agreement::judge::cause(j) {
+            eprintln!(
+                "seed {} {:?}: {c}; drifts {:?}",
+                j.seed, j.objects, j.rest_drifts
+            );
+        }
+    }
+    judged
+}
+
+fn print_table(engine: &str, seeds: &std::ops::Range<u64>, s: &Summary) {
     let pct = |a: usize, n: usize| 100.0 * a as f64 / n.max(1) as f64;
-    println!("seeds {}..{} ({} scenes)", seeds.start, seeds.end, s.scenes);
+    if !seeds.is_empty() {
+        println!("seeds {}..{}", seeds.start, seeds.end);
+    }
+    println!("{engine}: {} scenes", s.scenes);
     println!("{:<44} {:>8}", "", "count");
     println!("{:<44} {:>8}", "we pass", s.we_pass);
-    println!("{:<44} {:>8}", "MuJoCo passes", s.mujoco_pass);
+    println!("{:<44} {:>8}", format!("{engine} passes"), s.mujoco_pass);
     println!(
         "{:<44} {:>8}  ({:.1} %)",
         "verdict agrees",
@@ -115,11 +208,19 @@ fn main() {
         s.rest_judged
     );
     println!("{:<44} {:>8}", "scenes with a marginal body", s.marginal);
+    println!(
+        "{:<44} {:>8}  (of {} marginal bodies; {} of {} other bodies)",
+        format!("marginal bodies {engine} moves"),
+        s.marginal_bodies_moved,
+        s.marginal_bodies,
+        s.stable_bodies_moved,
+        s.stable_bodies
+    );
     for (c, n) in &s.causes {
         println!("  {c:<70} {n:>4}");
     }
     println!(
-        "MuJoCo drift of bodies at rest: mean {:.3} mm / {:.3} deg, worst {:.3} mm / {:.3} deg",
+        "{engine} drift of bodies at rest: mean {:.3} mm / {:.3} deg, worst {:.3} mm / {:.3} deg",
         s.drift_mean_mm, s.drift_mean_deg, s.drift_worst_mm, s.drift_worst_deg
     );
     println!(

@@ -1,11 +1,12 @@
 //! The other engine's side: `tests/python/agreement_mujoco.py` replays every exported scene in
-//! MuJoCo (one process for a batch) and this module compares its answers with ours.
+//! MuJoCo (`scene.xml`), `tests/python/agreement_physx.py` in PhysX (`scene.usda`, ovphysx on
+//! the CPU), one process for a batch, and this module compares their answers with ours.
 //!
-//! MuJoCo's scene verdict ([`RULES`]) is the settle test's rule replayed from the `composed`
-//! keyframe: after 2 s every free body's centre of mass has moved at most 10 % of its
-//! bounding-box diagonal, and over the next 1 s it moves at most 1 mm and turns at most 1°.
-//! MuJoCo's rest answer: from the `settled` keyframe (the exported pose), every body stays
-//! within 1 mm and 1° for 2 s.
+//! The engine's scene verdict ([`RULES`]) is the settle test's rule replayed from the composed
+//! pose (MJCF keyframe `composed`; the USD's `customData` composed pose): after 2 s every free
+//! body's centre of mass has moved at most 10 % of its bounding-box diagonal, and over the next
+//! 1 s it moves at most 1 mm and turns at most 1°. The engine's rest answer: from the exported
+//! (settled) pose, every body stays within 1 mm and 1° for 2 s.
 
 use super::{Generated, Ours};
 use crate::error::{Error, Result};
@@ -13,18 +14,29 @@ use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
-/// MuJoCo's verdict rule, as written into the results.
-pub const RULES: &str = "from the composed pose: COM drift <= 10% of the bbox diagonal after 2 s, then <= 1 mm and <= 1 deg over 1 s; rest: <= 1 mm and <= 1 deg for 2 s from the settled pose";
+/// The engine's verdict rule, as written into the results.
+pub const RULES: &str = "from the composed pose: COM drift <= 10% of the bbox diagonal after 2 s and no turn > 30 deg that moves the shape by > 10% of the diagonal, then <= 1 mm and <= 1 deg over 1 s; rest: <= 1 mm and <= 1 deg for 2 s from the settled pose";
 /// Rest agreement thresholds.
 pub const REST_MM: f64 = 1.0;
 pub const REST_DEG: f64 = 1.0;
 
-/// What MuJoCo reported on one body.
+/// What the engine reported on one body.
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct MjBody {
     /// Composed-pose run: COM drift after the settle part (m), then the rest part's worst
     /// displacement (m) and turn (degrees).
     pub settle_m: f64,
+    /// Turn over the settle part (degrees) and the orientations it went between (w, x, y, z).
+    #[serde(default)]
+    pub settle_deg: f64,
+    #[serde(default)]
+    pub settle_q0: Option<[f64; 4]>,
+    #[serde(default)]
+    pub settle_q1: Option<[f64; 4]>,
+    /// The settle test's large-turn rule applied to that turn: how far it moved the body's
+    /// shape (m), when the turn passed the limit (filled in here, not by the script).
+    #[serde(default)]
+    pub settle_shape_shift: Option<f64>,
     pub rest_m: f64,
     pub rest_deg: f64,
     /// Settled-pose run: worst displacement (m) and turn (degrees) over 2 s.
@@ -32,7 +44,7 @@ pub struct MjBody {
     pub from_settled_deg: f64,
 }
 
-/// What MuJoCo reported on one scene.
+/// What the engine reported on one scene.
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct MjScene {
     pub dir: PathBuf,
@@ -45,6 +57,8 @@ pub struct MjScene {
 /// One scene, both engines.
 #[derive(Clone, Debug, Serialize)]
 pub struct Judged {
+    /// The other engine's name (`MuJoCo`, `PhysX`).
+    pub engine: String,
     pub seed: u64,
     pub kind: super::Kind,
     pub objects: Vec<String>,
@@ -54,14 +68,17 @@ pub struct Judged {
     pub verdict_agrees: bool,
     /// `None` when we fail the scene (no rest pose claimed).
     pub rest_agrees: Option<bool>,
-    /// Bodies we call at rest that MuJoCo moves past 1 mm / 1° (name, mm, degrees).
+    /// Bodies of a scene we pass (marginal ones included) that the engine moves past 1 mm / 1°
+    /// (name, mm, degrees).
     pub rest_drifts: Vec<(String, f64, f64)>,
     /// Our own honesty flag: the scene had a body our probe calls marginal.
     pub marginal: bool,
 }
 
-/// Run the MuJoCo judge on exported scenes (`dirs[i]` holds the export of `scenes[i]`).
+/// Run a judge script (`engine` names it in causes) on exported scenes (`scenes[i].2` holds
+/// the export of `scenes[i].0`).
 pub fn judge(
+    engine: &str,
     python: &str,
     script: &Path,
     scenes: &[(Generated, Ours, PathBuf)],
@@ -115,15 +132,48 @@ pub fn judge(
     Ok(scenes
         .iter()
         .zip(results)
-        .map(|((g, ours, _), mj)| compare(g, ours, mj))
+        .map(|((g, ours, _), mj)| compare(engine, g, ours, mj))
         .collect())
 }
 
-fn compare(g: &Generated, ours: &Ours, mj: MjScene) -> Judged {
+/// The settle test's large-turn rule on the engine's settle part: a body that turned more than
+/// the limit fails when the turn moved its shape by more than the drift limit (a pen rolling
+/// about its own axis does not). The scripts report the turn; the hulls are here.
+fn large_turns(g: &Generated, ours: &Ours, mj: &mut MjScene) {
+    let o = crate::physics::SettleOptions::default();
+    let sims = crate::validate::sim_bodies(&g.assembly);
+    let quat = |q: [f64; 4]| {
+        nalgebra::UnitQuaternion::from_quaternion(nalgebra::Quaternion::new(q[0], q[1], q[2], q[3]))
+    };
+    for (name, b) in mj.bodies.iter_mut() {
+        let (Some(q0), Some(q1)) = (b.settle_q0, b.settle_q1) else {
+            continue;
+        };
+        if b.settle_deg <= o.max_settle_rotation_deg {
+            continue;
+        }
+        let (Some(sim), Some(ob)) = (
+            sims.iter().find(|s| &s.name == name),
+            ours.bodies.iter().find(|s| &s.name == name),
+        ) else {
+            continue;
+        };
+        if let Ok(shift) = crate::physics::shape_shift(sim, &quat(q0), &quat(q1)) {
+            b.settle_shape_shift = Some(shift);
+            if shift > o.max_relative_drift * ob.diagonal {
+                mj.passed = false;
+            }
+        }
+    }
+}
+
+fn compare(engine: &str, g: &Generated, ours: &Ours, mut mj: MjScene) -> Judged {
+    large_turns(g, ours, &mut mj);
     let mut rest_drifts = Vec::new();
     if ours.passed {
-        // A marginal body is not claimed to be at rest (it is reported as marginal instead).
-        for b in ours.bodies.iter().filter(|b| !b.marginal) {
+        // Every body of a scene we pass counts, marginal or not: export ships that pose either
+        // way (the marginal flag is only a warning; the summary counts how well it predicts).
+        for b in &ours.bodies {
             if let Some(m) = mj.bodies.get(&b.name) {
                 let (mm, deg) = (m.from_settled_m * 1e3, m.from_settled_deg);
                 if !(mm <= REST_MM && deg <= REST_DEG) {
@@ -133,6 +183,7 @@ fn compare(g: &Generated, ours: &Ours, mj: MjScene) -> Judged {
         }
     }
     Judged {
+        engine: engine.to_string(),
         seed: g.seed,
         kind: g.kind,
         objects: g.objects.clone(),
@@ -156,6 +207,12 @@ pub struct Summary {
     pub rest_judged: usize,
     pub rest_agree: usize,
     pub marginal: usize,
+    /// Bodies of scenes we pass that our probe calls marginal, and how many of them the engine
+    /// moved past 1 mm / 1° from the exported pose; the same for the bodies it calls stable.
+    pub marginal_bodies: usize,
+    pub marginal_bodies_moved: usize,
+    pub stable_bodies: usize,
+    pub stable_bodies_moved: usize,
     /// Disagreements by cause (a short key: direction and what moved).
     pub causes: BTreeMap<String, usize>,
     /// Mean and worst settle (validation) time per scene (s).
@@ -179,7 +236,8 @@ pub fn cause(j: &Judged) -> Option<String> {
                 .map(|(n, b)| (n, b.rest_m.max(b.settle_m)))
                 .max_by(|a, b| a.1.total_cmp(&b.1));
             format!(
-                "verdict: we pass, MuJoCo fails ({:?}; {})",
+                "verdict: we pass, {} fails ({:?}; {})",
+                j.engine,
                 j.kind,
                 worst.map(|w| w.0.as_str()).unwrap_or("?")
             )
@@ -198,12 +256,15 @@ pub fn cause(j: &Judged) -> Option<String> {
                         .collect()
                 })
                 .unwrap_or_default();
-            format!("verdict: we fail, MuJoCo passes ({:?}; {first})", j.kind)
+            format!(
+                "verdict: we fail, {} passes ({:?}; {first})",
+                j.engine, j.kind
+            )
         });
     }
     if j.rest_agrees == Some(false) {
         let (name, _, _) = &j.rest_drifts[0];
-        return Some(format!("rest: {name} moves in MuJoCo ({:?})", j.kind));
+        return Some(format!("rest: {name} moves in {} ({:?})", j.engine, j.kind));
     }
     None
 }
@@ -228,6 +289,14 @@ pub fn summary(js: &[Judged]) -> Summary {
                 if let Some(m) = j.mujoco.bodies.get(&b.name) {
                     drift_mm.push(m.from_settled_m * 1e3);
                     drift_deg.push(m.from_settled_deg);
+                    let moved = j.rest_drifts.iter().any(|d| d.0 == b.name) as usize;
+                    if b.marginal {
+                        s.marginal_bodies += 1;
+                        s.marginal_bodies_moved += moved;
+                    } else {
+                        s.stable_bodies += 1;
+                        s.stable_bodies_moved += moved;
+                    }
                 }
             }
         }

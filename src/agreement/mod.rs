@@ -270,9 +270,19 @@ pub struct OurBody {
 /// Validate a generated scene as `export` does (static collision penetration + settle test;
 /// the visual-mesh metrics are left out since no engine sees visual meshes) and export it.
 pub fn run_scene(g: &Generated, out: &Path) -> Result<Ours> {
+    run_scene_with(g, out, &crate::physics::SettleOptions::default())
+}
+
+/// [`run_scene`] with other settle options (experiments on the settle test).
+pub fn run_scene_with(
+    g: &Generated,
+    out: &Path,
+    settle: &crate::physics::SettleOptions,
+) -> Result<Ours> {
     let mut a = g.assembly.clone();
     let opts = crate::validate::ValidateOptions {
         visual_metrics: false,
+        settle: settle.clone(),
         ..Default::default()
     };
     let t = std::time::Instant::now();

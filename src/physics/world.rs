@@ -519,3 +519,21 @@ pub(super) fn body_builder(
     act.time_until_sleep = opts.sleep_time;
     Ok((rb, diag))
 }
+
+/// How far turning `body` from orientation `from` to orientation `to` about its centre of mass
+/// moves its shape (m): the settle test's measure of a large turn ([`BodyReport::settle_shape_shift`]),
+/// for a turn another engine reports.
+pub fn shape_shift(
+    body: &SimBody,
+    from: &UnitQuaternion<f64>,
+    to: &UnitQuaternion<f64>,
+) -> Result<f64, PhysicsError> {
+    let opts = SettleOptions::default();
+    let alone = SimBody {
+        pose: Isometry3::identity(),
+        ..body.clone()
+    };
+    let sim = Sim::new(std::slice::from_ref(&alone), &opts)?;
+    let at = |q: &UnitQuaternion<f64>| Isometry3::from_parts(Translation3::identity(), *q);
+    Ok(sim.shape_shift(0, &at(from), &at(to)))
+}

@@ -7,6 +7,9 @@ prints one JSON line on stdout:
 - from the "composed" keyframe: simulate 2 s (settle), then 1 s (rest). A free body passes when
   its centre of mass moved at most 10 % of its bounding-box diagonal over the settle part and at
   most 1 mm / 1 degree over the rest part (the settle test's rule); the scene passes when all do;
+  the turn over the settle part is reported too (settle_deg, and the start and end orientations
+  settle_q0/settle_q1 as w, x, y, z): the caller applies the settle test's large-turn rule, which
+  needs the hulls;
 - from the "settled" keyframe (the exported pose; "composed" if there is none): the worst
   displacement and turn of each body over 2 s.
 Body positions are MuJoCo's xpos: the body frame, which the export puts at the centre of mass.
@@ -77,13 +80,21 @@ def judge(entry):
     composed = snapshot(data, bodies)
     _, finite1 = run(model, data, SETTLE_S, bodies, composed)
     settle = {b: float(np.linalg.norm(data.xpos[b] - composed[b][0])) for b in bodies}
+    turned = {b: data.xquat[b].copy() for b in bodies}
     rest, finite2 = run(model, data, REST_S, bodies, snapshot(data, bodies))
     passed = finite1 and finite2
     out = {}
     for b in bodies:
         ok = settle[b] <= 0.10 * diag.get(names[b], float("inf")) and rest[b][0] <= 1e-3 and rest[b][1] <= 1.0
         passed = passed and ok
-        out[names[b]] = {"settle_m": settle[b], "rest_m": rest[b][0], "rest_deg": rest[b][1]}
+        out[names[b]] = {
+            "settle_m": settle[b],
+            "settle_deg": angle_deg(composed[b][1], turned[b]),
+            "settle_q0": [float(x) for x in composed[b][1]],
+            "settle_q1": [float(x) for x in turned[b]],
+            "rest_m": rest[b][0],
+            "rest_deg": rest[b][1],
+        }
 
     reset(model, data, "settled")
     worst, finite3 = run(model, data, FROM_SETTLED_S, bodies, snapshot(data, bodies))

@@ -1,0 +1,214 @@
+"""PhysX's side of the rest-agreement generator (src/agreement): replay exported scenes' USD.
+
+usage: agreement_physx.py LIST.json
+
+Same input and output as agreement_mujoco.py (one JSON line per scene on stdout), with PhysX
+(ovphysx, CPU) simulating OUT/scene.usda instead of MuJoCo simulating OUT/scene.xml:
+- from the composed pose (customData "interact3d" composedTranslation/composedOrientation of each
+  object prim, written into a copy of scene.usda beside it): simulate 2 s (settle), then 1 s
+  (rest). A free body passes when its centre of mass moved at most 10 % of its bounding-box
+  diagonal over the settle part and at most 1 mm / 1 degree over the rest part; the scene passes
+  when all do; the turn over the settle part is reported (settle_deg, settle_q0, settle_q1 as
+  w, x, y, z) for the caller's large-turn rule;
+- from scene.usda as exported (the settled pose): the worst displacement and turn of each body
+  over 2 s.
+Poses are PhysX's rigid-body poses, read every step (the export puts the body frame at the
+centre of mass). Time step 1/240 s, PhysX's defaults otherwise (what scene.usda says).
+Engine chatter goes to stderr.
+"""
+import contextlib
+import gc
+import json
+import math
+import os
+import sys
+import time
+
+import numpy as np
+
+DT = 1.0 / 240.0
+SETTLE_S = 2.0
+REST_S = 1.0
+FROM_SETTLED_S = 2.0
+
+
+@contextlib.contextmanager
+def stdout_to_stderr():
+    sys.stdout.flush()
+    saved = os.dup(1)
+    os.dup2(2, 1)
+    try:
+        yield
+    finally:
+        sys.stdout.flush()
+        os.dup2(saved, 1)
+        os.close(saved)
+
+
+def angle_deg(q0, q1):
+    d = abs(float(np.dot(q0, q1)) / (np.linalg.norm(q0) * np.linalg.norm(q1)))
+    return math.degrees(2.0 * math.acos(min(1.0, d)))
+
+
+def wxyz(q):
+    """PhysX orientations are (x, y, z, w)."""
+    return [float(q[3]), float(q[0]), float(q[1]), float(q[2])]
+
+
+def composed_copy(scene_dir):
+    """scene.usda with every object prim moved to its composed pose, written beside it (so the
+    object references resolve); returns (path, {prim path: object name})."""
+    from pxr import Gf, Usd
+
+    stage = Usd.Stage.Open(os.path.join(scene_dir, "scene.usda"))
+    names = {}
+    for prim in stage.GetPseudoRoot().GetChild("World").GetChildren():
+        custom = prim.GetCustomDataByKey("interact3d")
+        if not custom:
+            continue
+        names[str(prim.GetPath())] = custom["name"]
+        t = custom.get("composedTranslation")
+        q = custom.get("composedOrientation")
+        if t is not None and q is not None:
+            prim.GetAttribute("xformOp:translate").Set(Gf.Vec3d(*t))
+            prim.GetAttribute("xformOp:orient").Set(Gf.Quatd(q.GetReal(), q.GetImaginary()))
+    path = os.path.join(scene_dir, "scene_composed.usda")
+    stage.GetRootLayer().Export(path)
+    return path, names
+
+
+class Run:
+    """One PhysX world on one USD file."""
+
+    def __init__(self, path):
+        import ovstage
+        from ovphysx import PhysX
+
+        self.physx = PhysX()
+        self.stage = ovstage.Stage("interact3d-agreement")
+        ovstage.population.open_usd(
+            self.stage, path, ordinal=1, domains=ovstage.PopulationDomain.ALL
+        )
+        self.stage.advance_write_floor(ordinal=1).wait()
+        self.physx.wait_task(self.physx.attach_ovstage(self.stage, read_ordinal=1))
+
+    def poses(self):
+        from ovphysx.types import ObjectScope, SimObjectType
+
+        rows = {}
+        attrs = ["position", "orientation"]
+        with self.physx.read_sync(SimObjectType.RIGID_BODY, attrs, scope=ObjectScope.ALL) as result:
+            paths = result.dictionary
+            for g in result.groups:
+                if g.is_delete or g.is_array or not g.tensors:
+                    continue
+                names = paths.get_path_strings(g.prim_list)
+                attr = paths.token_to_string(g.attribute)
+                vals = g.tensors[0].numpy().copy()
+                for i, p in enumerate(names):
+                    rows.setdefault(p, {})[attr] = np.array(vals[i], dtype=float)
+        return {p: (r["position"], r["orientation"]) for p, r in rows.items() if len(r) == 2}
+
+    def run(self, seconds, start):
+        """Step `seconds`; worst displacement and turn of each body from `start`."""
+        worst = {p: [0.0, 0.0] for p in start}
+        finite = True
+        for _ in range(int(round(seconds / DT))):
+            self.physx.step_sync(DT)
+            now = self.poses()
+            for p, (x0, q0) in start.items():
+                x, q = now.get(p, (x0, q0))
+                if not (np.all(np.isfinite(x)) and np.all(np.isfinite(q))):
+                    finite = False
+                    continue
+                worst[p][0] = max(worst[p][0], float(np.linalg.norm(x - x0)))
+                worst[p][1] = max(worst[p][1], angle_deg(q0, q))
+        return worst, finite
+
+    def close(self):
+        gc.collect()
+        self.physx.wait_all()
+        self.physx.wait_task(self.physx.detach_ovstage())
+        self.stage.destroy()
+        self.physx.destroy()
+
+
+def dynamic_only(poses, names):
+    return {p: v for p, v in poses.items() if p in names}
+
+
+def judge(entry):
+    t0 = time.time()
+    d = entry["dir"]
+    diag = entry["diagonals"]
+    composed_path, names = composed_copy(d)
+    out = {}
+    try:
+        r = Run(composed_path)
+        composed = dynamic_only(r.poses(), names)
+        _, finite1 = r.run(SETTLE_S, composed)
+        after = r.poses()
+        settle = {p: float(np.linalg.norm(after[p][0] - composed[p][0])) for p in composed}
+        rest, finite2 = r.run(REST_S, {p: after[p] for p in composed})
+        r.close()
+    finally:
+        os.remove(composed_path)
+    passed = finite1 and finite2
+    for p in composed:
+        n = names[p]
+        ok = settle[p] <= 0.10 * diag.get(n, float("inf")) and rest[p][0] <= 1e-3 and rest[p][1] <= 1.0
+        passed = passed and ok
+        q0, q1 = wxyz(composed[p][1]), wxyz(after[p][1])
+        out[n] = {
+            "settle_m": settle[p],
+            "settle_deg": angle_deg(q0, q1),
+            "settle_q0": q0,
+            "settle_q1": q1,
+            "rest_m": rest[p][0],
+            "rest_deg": rest[p][1],
+        }
+
+    r = Run(os.path.join(d, "scene.usda"))
+    start = dynamic_only(r.poses(), names)
+    worst, finite3 = r.run(FROM_SETTLED_S, start)
+    r.close()
+    for p in start:
+        out[names[p]]["from_settled_m"] = worst[p][0]
+        out[names[p]]["from_settled_deg"] = worst[p][1]
+    return {
+        "dir": d,
+        "passed": bool(passed),
+        "finite": bool(finite1 and finite2 and finite3),
+        "bodies": out,
+        "seconds": time.time() - t0,
+    }
+
+
+def main():
+    with open(sys.argv[1]) as f:
+        entries = json.load(f)
+    with stdout_to_stderr():
+        import ovphysx
+        import ovstage
+        import physx_usd_schemas
+        from ovphysx import PhysX
+        from ovphysx.samples.python_samples.schema_support import physx_schema_paths
+        from ovphysx.types import GlobalConfigKey
+
+        physx_usd_schemas.register_all()
+        ovphysx.set_global_config(GlobalConfigKey.NUM_THREADS, 0)
+        PhysX.set_cpu_mode(True)
+        roots = [str(p) for p in physx_schema_paths()]
+        try:
+            roots.append(str(ovphysx.newton_schema_root()))
+        except FileNotFoundError:
+            pass
+        ovstage.population.register_usd_schemas(roots)
+    for e in entries:
+        with stdout_to_stderr():
+            res = judge(e)
+        print(json.dumps(res, sort_keys=True), flush=True)
+
+
+if __name__ == "__main__":
+    main()
