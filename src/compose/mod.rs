@@ -30,6 +30,7 @@ pub mod obb;
 pub mod occlusion;
 pub mod plane_icp;
 pub mod realistic;
+pub mod reconstruction;
 pub mod refine;
 pub mod scale;
 pub mod sdf;
