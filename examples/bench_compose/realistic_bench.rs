@@ -247,9 +247,9 @@ pub fn run(args: &[String]) {
                         let id = if n == 0 { sid } else { iid };
                         if verbose && !(add < 0.02 && scale < 0.03) {
                             eprintln!(
-                                "  MISS {id:<44} (pair {k:2}, seed {seed}) ADD-S {:6.2} % scale {:6.2} % [{}]",
+                                "  MISS {id:<44} (pair {k:2}, seed {seed}) ADD-S {:6.2} % scale {:+6.2} % [{}]",
                                 100.0 * add,
-                                100.0 * scale,
+                                100.0 * (est.scale / s.truth[n].scale - 1.0),
                                 r.method
                             );
                         }

@@ -205,7 +205,10 @@ fn max_filter(g: &Grid, v: &mut [f32], r: usize) {
             for (t, d) in dst.iter_mut().enumerate() {
                 let lo = t.saturating_sub(r);
                 let hi = (t + r + 1).min(n);
-                *d = src[lo..hi].iter().cloned().fold(f32::NEG_INFINITY, f32::max);
+                *d = src[lo..hi]
+                    .iter()
+                    .cloned()
+                    .fold(f32::NEG_INFINITY, f32::max);
             }
         });
     }
@@ -341,10 +344,8 @@ pub fn make(objects: &[TruthObject], seed: u64, o: &ReconOptions) -> Synthetic {
         .filter_map(|t| t.visual.geometry().transformed(&t.pose.matrix()).aabb())
         .reduce(|a, b| a.union(&b))
         .expect("scene has geometry");
-    let yaw = UnitQuaternion::from_axis_angle(
-        &Vector3::y_axis(),
-        rng.range(0.0, std::f64::consts::TAU),
-    );
+    let yaw =
+        UnitQuaternion::from_axis_angle(&Vector3::y_axis(), rng.range(0.0, std::f64::consts::TAU));
     let tilt_axis = Vector3::new(rng.range(-1.0, 1.0), 0.0, rng.range(-1.0, 1.0));
     let tilt = UnitQuaternion::from_axis_angle(
         &nalgebra::Unit::new_normalize(tilt_axis + Vector3::new(1e-9, 0.0, 0.0)),
@@ -400,7 +401,11 @@ pub fn make(objects: &[TruthObject], seed: u64, o: &ReconOptions) -> Synthetic {
     // The true surface, finely sampled, and a tree per object.
     let all = samples(&placed, h / 3.0, &mut rng);
     let by_obj: Vec<Vec<usize>> = (0..placed.len())
-        .map(|oi| (0..all.len()).filter(|&s| all[s].obj as usize == oi).collect())
+        .map(|oi| {
+            (0..all.len())
+                .filter(|&s| all[s].obj as usize == oi)
+                .collect()
+        })
         .collect();
     let trees: Vec<KdTree> = by_obj
         .iter()
@@ -521,11 +526,7 @@ pub fn make(objects: &[TruthObject], seed: u64, o: &ReconOptions) -> Synthetic {
     for idx in 0..n_pts {
         if let Some((s, d)) = vals[idx] {
             if (depth[idx] as f64) < 1.2 * sigma {
-                let thin = if s < 0.0 {
-                    -tau
-                } else {
-                    d as f64 - tau
-                };
+                let thin = if s < 0.0 { -tau } else { d as f64 - tau };
                 field[idx] = field[idx].min(thin as f32);
             }
         }
