@@ -2,6 +2,7 @@
 //! `compose::realistic`, ADD-S and scale per object, success per seed, time per pair.
 
 use interact3d::compose::realistic::{self, AddS, SourceObject};
+use interact3d::compose::reconstruction::{self, ReconOptions};
 use interact3d::compose::{compose, ComposeOptions};
 use interact3d::metrics::{pair_metrics, MetricsOptions, Prepared, Solid};
 use interact3d::rng::Rng;
@@ -155,6 +156,8 @@ pub fn run(args: &[String]) {
         .map(|s| s.split(',').map(str::to_string).collect())
         .unwrap_or_default();
     let verbose = args.iter().any(|a| a == "-v");
+    // The earlier realistic guidance: the objects' own surfaces, subdivided, with holes.
+    let subdivided = args.iter().any(|a| a == "--subdivided");
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
     let objects = root.join("../shared/datasets/objects");
     if !objects.is_dir() {
@@ -195,11 +198,28 @@ pub fn run(args: &[String]) {
                         rng.next_u64();
                     }
                     let scene = realistic::pair_scene(&support, &item, spread, &mut rng);
-                    let s = realistic::make(
-                        &scene,
-                        rng.next_u64(),
-                        &realistic::RealisticOptions::default(),
-                    );
+                    let gen_seed = rng.next_u64();
+                    let t_gen = Instant::now();
+                    let s = if subdivided {
+                        realistic::make(&scene, gen_seed, &realistic::RealisticOptions::default())
+                    } else {
+                        reconstruction::make(&scene, gen_seed, &ReconOptions::default())
+                    };
+                    if verbose {
+                        let tris: Vec<String> = s
+                            .inputs
+                            .iter()
+                            .zip(&s.removed)
+                            .map(|(i, r)| {
+                                format!("{} tris, {:.0} % removed", i.guidance.triangle_count(), 100.0 * r)
+                            })
+                            .collect();
+                        eprintln!(
+                            "pair {k:2} seed {seed}: guidance {} ({:.1} s)",
+                            tris.join(" / "),
+                            t_gen.elapsed().as_secs_f64()
+                        );
+                    }
                     let o = ComposeOptions {
                         seed,
                         ..Default::default()
@@ -227,9 +247,9 @@ pub fn run(args: &[String]) {
                         let id = if n == 0 { sid } else { iid };
                         if verbose && !(add < 0.02 && scale < 0.03) {
                             eprintln!(
-                                "  MISS {id:<44} (pair {k:2}, seed {seed}) ADD-S {:6.2} % scale {:6.2} % [{}]",
+                                "  MISS {id:<44} (pair {k:2}, seed {seed}) ADD-S {:6.2} % scale {:+6.2} % [{}]",
                                 100.0 * add,
-                                100.0 * scale,
+                                100.0 * (est.scale / s.truth[n].scale - 1.0),
                                 r.method
                             );
                         }
@@ -280,7 +300,8 @@ pub fn run(args: &[String]) {
     let ok5 = |r: &Record| r.add_s < 0.05 && r.scale < 0.05;
 
     println!(
-        "\n#### Realistic guidance: {} pairs × {seeds} seeds (generator seeds 7000+s, pipeline seeds s = {offset}..{})\n",
+        "\n#### Realistic guidance ({}): {} pairs × {seeds} seeds (generator seeds 7000+s, pipeline seeds s = {offset}..{})\n",
+        if subdivided { "subdivided object surfaces" } else { "separate reconstruction" },
         pairs.len(),
         offset + seeds
     );

@@ -9,7 +9,8 @@
 //! 3. global registration ([`global`]): hypotheses from the 24 OBB axis permutations and from
 //!    FPFH + RANSAC ([`features`]), each refined by a short trimmed ICP and scored (colour-
 //!    weighted when both meshes carry colour, [`colour`]);
-//! 4. scale-aware trimmed ICP with Umeyama and a bounded scale ([`icp`]);
+//! 4. scale-aware trimmed ICP with Umeyama and a bounded scale ([`icp`]), on the guidance part
+//!    without the placed objects' surface (segmentation bleed, [`bleed`]);
 //! 5. collision-aware refinement of every further object against the fixed, already composed
 //!    objects' signed distance field ([`sdf`], [`refine`](mod@refine)); objects are added one
 //!    at a time, the composed scene becoming the new anchor.
@@ -18,6 +19,7 @@
 //! scenes for tests and the benchmark; [`folder`] reads sample folders and writes the output.
 
 pub mod agent;
+pub mod bleed;
 pub mod cloud;
 pub mod colour;
 pub mod features;
@@ -30,6 +32,7 @@ pub mod obb;
 pub mod occlusion;
 pub mod plane_icp;
 pub mod realistic;
+pub mod reconstruction;
 pub mod refine;
 pub mod scale;
 pub mod sdf;
@@ -488,7 +491,15 @@ pub fn compose(inputs: &[ObjectInput], o: &ComposeOptions) -> Result<Composition
         let inp = &inputs[i];
         let seed = name_seed(o.seed, &inp.name);
         let mut object = Cloud::sample(&inp.visual, o.object_samples, seed);
-        let guidance = &guidances[i];
+        // The placed objects' surface in this part is segmentation bleed ([`bleed`]): within
+        // 1.5 % of the part's diagonal, or 1 % of the scene's (the placed part's own noise and
+        // pose error, for a small object next to a large one), of a placed object, a point
+        // belongs to that object.
+        let stripped = field.as_ref().and_then(|f| {
+            let d = crate::mesh::Aabb::of_points(&guidances[i].points)?.diagonal();
+            bleed::without_placed(&guidances[i], f, (0.015 * d).max(0.01 * unit), 0.5)
+        });
+        let guidance = stripped.as_ref().unwrap_or(&guidances[i]);
         colour::normalise(&mut object);
         // What hides this object: the placed meshes of the objects composed before it
         // (complete surfaces), the guidance parts of the others (holey).
