@@ -698,6 +698,7 @@ fn validate(a: ValidateArgs) -> Result<ExitCode, Error> {
     opts.asset.physics = !a.no_physics;
     opts.asset.settle = interact3d::physics::SettleOptions {
         perturbation_speed: opts.asset.settle.perturbation_speed,
+        settle_max_time: opts.asset.settle.settle_max_time,
         ..a.check.options().settle
     };
     if let Some(b) = &a.baseline {
