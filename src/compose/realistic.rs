@@ -266,11 +266,7 @@ fn hash3(p: &P3, seed: u64) -> u64 {
 /// Guidance parts for a ground-truth scene (see the module doc).
 pub fn make(objects: &[TruthObject], seed: u64, o: &RealisticOptions) -> Synthetic {
     let mut rng = Rng::new(seed ^ 0x0BAD_5EED_1234_5678);
-    let scene_bb = objects
-        .iter()
-        .filter_map(|t| t.visual.geometry().transformed(&t.pose.matrix()).aabb())
-        .reduce(|a, b| a.union(&b))
-        .expect("scene has geometry");
+    let scene_bb = super::synth::scene_box(objects);
     let diag = scene_bb.diagonal();
     let tilt_axis = Vector3::new(rng.range(-1.0, 1.0), 0.0, rng.range(-1.0, 1.0));
     let tilt = UnitQuaternion::from_axis_angle(

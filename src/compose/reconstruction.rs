@@ -339,11 +339,7 @@ fn unit_f(h: u64) -> f64 {
 /// Guidance parts for a ground-truth scene (see the module doc).
 pub fn make(objects: &[TruthObject], seed: u64, o: &ReconOptions) -> Synthetic {
     let mut rng = Rng::new(seed ^ 0x5EC0_4517_0C7E_D000);
-    let scene_bb = objects
-        .iter()
-        .filter_map(|t| t.visual.geometry().transformed(&t.pose.matrix()).aabb())
-        .reduce(|a, b| a.union(&b))
-        .expect("scene has geometry");
+    let scene_bb = super::synth::scene_box(objects);
     let yaw =
         UnitQuaternion::from_axis_angle(&Vector3::y_axis(), rng.range(0.0, std::f64::consts::TAU));
     let tilt_axis = Vector3::new(rng.range(-1.0, 1.0), 0.0, rng.range(-1.0, 1.0));

@@ -103,6 +103,16 @@ impl Synthetic {
     }
 }
 
+/// The box of a ground-truth scene: every object at its true pose. The guidance generators
+/// size their frame, holes and noise from it.
+pub fn scene_box(objects: &[TruthObject]) -> crate::mesh::Aabb {
+    objects
+        .iter()
+        .filter_map(|t| t.visual.geometry().transformed(&t.pose.matrix()).aabb())
+        .reduce(|a, b| a.union(&b))
+        .expect("scene has geometry")
+}
+
 /// Read a ground-truth sample folder (objects + their poses in metadata.json).
 pub fn load_truth(dir: &Path) -> Result<Vec<TruthObject>> {
     let scene = crate::scene::sample::load(dir, &Limits::default())?;
@@ -214,11 +224,7 @@ fn keep_triangles(part: &VisualPart, keep: &[bool]) -> VisualPart {
 pub fn make(objects: &[TruthObject], seed: u64, o: &SynthOptions) -> Synthetic {
     let mut rng = Rng::new(seed);
     // The guidance frame.
-    let scene_bb = objects
-        .iter()
-        .filter_map(|t| t.visual.geometry().transformed(&t.pose.matrix()).aabb())
-        .reduce(|a, b| a.union(&b))
-        .expect("scene has geometry");
+    let scene_bb = scene_box(objects);
     let diag = scene_bb.diagonal();
     let yaw =
         UnitQuaternion::from_axis_angle(&Vector3::y_axis(), rng.range(0.0, std::f64::consts::TAU));

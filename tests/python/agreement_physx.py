@@ -16,10 +16,8 @@ Poses are PhysX's rigid-body poses, read every step (the export puts the body fr
 centre of mass). Time step 1/240 s, PhysX's defaults otherwise (what scene.usda says).
 Engine chatter goes to stderr.
 """
-import contextlib
 import gc
 import json
-import math
 import os
 import sys
 import time
@@ -32,22 +30,9 @@ REST_S = 1.0
 FROM_SETTLED_S = 2.0
 
 
-@contextlib.contextmanager
-def stdout_to_stderr():
-    sys.stdout.flush()
-    saved = os.dup(1)
-    os.dup2(2, 1)
-    try:
-        yield
-    finally:
-        sys.stdout.flush()
-        os.dup2(saved, 1)
-        os.close(saved)
-
-
-def angle_deg(q0, q1):
-    d = abs(float(np.dot(q0, q1)) / (np.linalg.norm(q0) * np.linalg.norm(q1)))
-    return math.degrees(2.0 * math.acos(min(1.0, d)))
+# The PhysX driver's helpers (this folder is the script's own, first on sys.path).
+from check_usd import quat_angle_deg as angle_deg
+from check_usd import stdout_to_stderr
 
 
 def wxyz(q):
