@@ -158,16 +158,13 @@ pub fn percentile(d: &[f64], q: f64) -> f64 {
 }
 
 /// The boundary of the union of `hulls` as a triangle surface: the hulls' faces less the
-/// parts inside another hull. A face triangle with its three corners within 1e-6 of the
-/// diagonal of one other hull lies in it (convexity) and goes, seams between hulls that meet
-/// on a cut plane included; one that a neighbour's box reaches is quartered down to edges of
-/// [`BOUNDARY_EDGE`] of the diagonal while another hull may cut it (no face plane of that
-/// hull has all three corners beyond it), and the pieces not inside one hull are kept. Distances
-/// to it are exact where no hull crosses a face, and short by at most that edge next to where
-/// one does.
+/// parts inside another hull, cut exactly. Each face triangle is clipped against every other
+/// hull whose box it reaches, grown by 1e-6 of the diagonal (so that a face on a cut plane
+/// two hulls share counts as inside where the neighbour's face covers it): what lies beyond
+/// one of the neighbour's face planes is kept as convex polygons, the rest goes. The pieces
+/// are fanned into triangles. Distances to it are exact up to that 1e-6.
 pub fn union_boundary(hulls: &[Hull], diag: f64) -> Option<Surface> {
     let eps = 1e-6 * diag;
-    let min_edge = BOUNDARY_EDGE * diag;
     let tris: Vec<Vec<[P3; 3]>> = hulls
         .par_iter()
         .enumerate()
@@ -179,40 +176,24 @@ pub fn union_boundary(hulls: &[Hull], diag: f64) -> Option<Surface> {
                 .map(|(_, g)| g)
                 .collect();
             let mut out = Vec::new();
-            let mut stack: Vec<[P3; 3]> = h
-                .triangles
-                .iter()
-                .map(|t| t.map(|k| h.vertices[k as usize]))
-                .collect();
-            stack.reverse();
-            while let Some(t) = stack.pop() {
-                if others.iter().any(|g| t.iter().all(|p| g.holds(p, eps))) {
-                    continue; // inside `g`
+            for t in &h.triangles {
+                let mut pieces = vec![t.map(|k| h.vertices[k as usize]).to_vec()];
+                for g in &others {
+                    pieces = pieces
+                        .into_iter()
+                        .flat_map(|poly| outside_of(poly, g, eps))
+                        .collect();
+                    if pieces.is_empty() {
+                        break;
+                    }
                 }
-                let Some(b) = Aabb::of_points(&t) else {
-                    continue;
-                };
-                // `g` may cut the triangle unless one of its face planes has all three
-                // corners beyond it.
-                let crossed = others.iter().any(|g| {
-                    g.aabb.intersects(&b, eps)
-                        && !g
-                            .planes
-                            .iter()
-                            .any(|(n, d)| t.iter().all(|p| n.dot(&p.coords) - d > eps))
-                });
-                let longest = (0..3)
-                    .map(|k| (t[(k + 1) % 3] - t[k]).norm())
-                    .fold(0.0, f64::max);
-                if crossed && longest > min_edge {
-                    let m =
-                        [0, 1, 2].map(|k| P3::from((t[k].coords + t[(k + 1) % 3].coords) / 2.0));
-                    stack.push([m[0], m[1], m[2]]);
-                    stack.push([m[2], m[1], t[2]]);
-                    stack.push([m[1], m[0], t[1]]);
-                    stack.push([t[0], m[0], m[2]]);
-                } else {
-                    out.push(t);
+                for poly in pieces {
+                    for k in 1..poly.len() - 1 {
+                        let tri = [poly[0], poly[k], poly[k + 1]];
+                        if (tri[1] - tri[0]).cross(&(tri[2] - tri[0])).norm() > 0.0 {
+                            out.push(tri);
+                        }
+                    }
                 }
             }
             out
@@ -227,9 +208,62 @@ pub fn union_boundary(hulls: &[Hull], diag: f64) -> Option<Surface> {
     Surface::new(&mesh)
 }
 
-/// Edge length (relative to the diagonal) down to which [`union_boundary`] splits the faces
-/// another hull crosses.
-pub const BOUNDARY_EDGE: f64 = 2e-3;
+/// The parts of the convex polygon `poly` outside `g` grown by `eps`, as convex polygons
+/// (none when it lies inside; `poly` itself when one face plane has it all beyond).
+fn outside_of(poly: Vec<P3>, g: &Hull, eps: f64) -> Vec<Vec<P3>> {
+    let Some(b) = Aabb::of_points(&poly) else {
+        return Vec::new();
+    };
+    if !g.aabb.intersects(&b, eps)
+        || g.planes
+            .iter()
+            .any(|(n, d)| poly.iter().all(|p| n.dot(&p.coords) - d > eps))
+    {
+        return vec![poly];
+    }
+    // Beyond plane k and within the planes before it: disjoint pieces whose union is the
+    // polygon less the grown hull.
+    let mut out = Vec::new();
+    let mut rest = poly;
+    for (n, d) in &g.planes {
+        let off = d + eps;
+        let beyond = clip_half(&rest, n, off, false);
+        if beyond.len() >= 3 {
+            out.push(beyond);
+        }
+        rest = clip_half(&rest, n, off, true);
+        if rest.len() < 3 {
+            break;
+        }
+    }
+    out
+}
+
+/// Sutherland–Hodgman: the part of the convex polygon `poly` with `n·x <= off` (`below`) or
+/// `n·x >= off`.
+fn clip_half(poly: &[P3], n: &V3, off: f64, below: bool) -> Vec<P3> {
+    let side = |p: &P3| {
+        let s = n.dot(&p.coords) - off;
+        if below {
+            -s
+        } else {
+            s
+        }
+    };
+    let mut out = Vec::with_capacity(poly.len() + 1);
+    for k in 0..poly.len() {
+        let (a, b) = (poly[k], poly[(k + 1) % poly.len()]);
+        let (sa, sb) = (side(&a), side(&b));
+        if sa >= 0.0 {
+            out.push(a);
+        }
+        if (sa >= 0.0) != (sb >= 0.0) {
+            let t = sa / (sa - sb);
+            out.push(a + (b - a) * t);
+        }
+    }
+    out
+}
 
 /// Measured quality of a set of hulls for one mesh.
 #[derive(Clone, Debug, Default, PartialEq)]
