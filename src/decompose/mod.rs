@@ -200,21 +200,13 @@ pub fn physx_legal(sets: &mut [Vec<Hull>], opts: &DecomposeOptions) -> Vec<Legal
         } else {
             PhysxLimits::default().max_polygon_vertices
         },
-        plane_tolerance: if opts.max_polygons == usize::MAX {
-            None
-        } else {
-            PhysxLimits::default().plane_tolerance
-        },
+        plane_tolerance: opts.plane_tolerance(),
     };
     sets.iter_mut()
         .map(|hulls| {
             let (mut reduced, mut over) = (0, 0);
             let seams = seam_vertices(hulls);
-            let pinned = |p: &crate::mesh::P3| {
-                seams
-                    .binary_search_by(|q| key_of(q).cmp(&key_of(p)))
-                    .is_ok()
-            };
+            let pinned = |p: &crate::mesh::P3| seams.binary_search(&key_of(p)).is_ok();
             let mut out = Vec::with_capacity(hulls.len());
             for h in hulls.drain(..) {
                 let before = h.vertices.len();
@@ -265,9 +257,9 @@ fn key_of(p: &crate::mesh::P3) -> [u64; 3] {
     [p.x.to_bits(), p.y.to_bits(), p.z.to_bits()]
 }
 
-/// The vertices (exactly equal coordinates) that two or more of `hulls` share, sorted by
-/// [`key_of`]: the seams where an object's pieces meet.
-fn seam_vertices(hulls: &[Hull]) -> Vec<crate::mesh::P3> {
+/// The keys ([`key_of`], sorted) of the vertices (exactly equal coordinates) that two or more
+/// of `hulls` share: the seams where an object's pieces meet.
+fn seam_vertices(hulls: &[Hull]) -> Vec<[u64; 3]> {
     let mut all: Vec<([u64; 3], usize)> = hulls
         .iter()
         .enumerate()
@@ -275,14 +267,10 @@ fn seam_vertices(hulls: &[Hull]) -> Vec<crate::mesh::P3> {
         .collect();
     all.sort_unstable();
     all.dedup();
-    let mut out: Vec<crate::mesh::P3> = Vec::new();
+    let mut out: Vec<[u64; 3]> = Vec::new();
     for w in all.windows(2) {
-        if w[0].0 == w[1].0 && out.last().is_none_or(|q| key_of(q) != w[0].0) {
-            out.push(crate::mesh::P3::new(
-                f64::from_bits(w[0].0[0]),
-                f64::from_bits(w[0].0[1]),
-                f64::from_bits(w[0].0[2]),
-            ));
+        if w[0].0 == w[1].0 && out.last() != Some(&w[0].0) {
+            out.push(w[0].0);
         }
     }
     out
