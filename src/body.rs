@@ -1,6 +1,7 @@
 //! Bodies: what a simulator gets for each object. The frame of a body is at its centre of mass
 //! with world-aligned axes at the composed pose; visual and collision geometry are expressed in it.
 
+use crate::decompose::scene_aware::geom::Surface;
 use crate::decompose::scene_aware::metrics::{self, TwoSided};
 use crate::decompose::{scene_aware::SceneAware, vhacd::Vhacd, DecomposeOptions, Decomposer, Hull};
 use crate::error::{Error, Result};
@@ -10,6 +11,7 @@ use crate::pose::Similarity;
 use crate::prepare::{prepare, PrepareOptions, PreparedScene};
 use crate::scene::Scene;
 use nalgebra::{Isometry3, Translation3, UnitQuaternion};
+use rayon::prelude::*;
 
 /// Smallest principal moment of inertia (kg·m²) written: MuJoCo 3/4 refuses a `fullinertia`
 /// whose eigenvalues are smaller ("inertia must have positive eigenvalues"; measured: 3e-15
@@ -113,6 +115,31 @@ pub fn build(scene: &Scene, opts: &BuildOptions) -> Result<Assembly> {
     )
 }
 
+/// Each object's two-sided figures ([`metrics::two_sided`]), the objects side by side, on the
+/// surfaces the engine built when it handed them over (`surfaces`, in order; an object
+/// without one gets its surface built here, as [`metrics::two_sided_of`] does). `None` for an
+/// object without hulls, which `assemble` refuses anyway.
+fn fidelities(
+    prepared: &PreparedScene,
+    hull_sets: &[Vec<Hull>],
+    surfaces: Vec<Option<Surface>>,
+) -> Vec<Option<TwoSided>> {
+    let mut surfaces = surfaces.into_iter();
+    let jobs: Vec<(&Mesh, &[Hull], Option<Surface>)> = prepared
+        .objects
+        .iter()
+        .zip(hull_sets)
+        .map(|(o, h)| (&o.geometry, h.as_slice(), surfaces.next().flatten()))
+        .collect();
+    jobs.into_par_iter()
+        .map(|(mesh, hulls, surface)| match surface {
+            _ if hulls.is_empty() => None,
+            Some(s) => metrics::two_sided(&s, hulls, metrics::TWO_SIDED_SAMPLES),
+            None => metrics::two_sided_of(mesh, hulls),
+        })
+        .collect()
+}
+
 /// Decompose a prepared scene and compute its bodies.
 pub fn assemble(
     prepared: &PreparedScene,
@@ -124,6 +151,7 @@ pub fn assemble(
     let mut hull_sets = engine.decompose(&meshes, &dopts.engine_budget())?;
     let legal = crate::decompose::physx_legal(&mut hull_sets, dopts);
     let notes = engine.object_warnings();
+    let mut fidelities = fidelities(prepared, &hull_sets, engine.take_surfaces());
     let mut bodies = Vec::with_capacity(prepared.objects.len());
     for (k, (o, hulls)) in prepared.objects.iter().zip(hull_sets).enumerate() {
         let density = o.physical.density.unwrap_or(DEFAULT_DENSITY);
@@ -165,7 +193,7 @@ pub fn assemble(
             ));
         }
         // Both directions, for every engine; the warning reads the headline figure.
-        let fidelity = metrics::two_sided_of(&o.geometry, &hulls);
+        let fidelity = fidelities[k].take();
         if let Some(f) = &fidelity {
             warnings.extend(metrics::tolerance_warning(
                 f,

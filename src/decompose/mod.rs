@@ -111,6 +111,13 @@ pub trait Decomposer: Send + Sync {
     fn object_warnings(&self) -> Vec<Vec<String>> {
         Vec::new()
     }
+    /// The objects' surfaces the last `decompose` call built, in order, handed over once (the
+    /// next call returns none): the fidelity measure (`body::assemble`) then need not build
+    /// them again from the same meshes. Empty by default, and when nothing was built (a cache
+    /// hit).
+    fn take_surfaces(&self) -> Vec<Option<scene_aware::geom::Surface>> {
+        Vec::new()
+    }
 }
 
 /// Bring raw hull point sets within the limits: build hulls, drop degenerate ones, merge down to

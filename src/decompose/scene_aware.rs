@@ -85,6 +85,7 @@
 //! the result depends on the neighbours.
 
 mod cells;
+mod engine;
 mod fit;
 pub mod geom;
 pub mod metrics;
@@ -95,13 +96,13 @@ mod refit;
 mod report;
 mod star;
 
+pub use engine::SceneAware;
 pub use report::{ObjectReport, SceneAwareReport};
 #[cfg(test)]
 use star::hidden;
 use star::{star, star_on_slabs, star_with_patches};
 
-use super::{cache, DecomposeOptions, Decomposer, Hull};
-use crate::error::Result;
+use super::{DecomposeOptions, Hull};
 use crate::mesh::{Mesh, P3, V3};
 use geom::{clip, distinct_sorted, farthest_points, greedy_hull, polyhedron, Surface};
 use rayon::prelude::*;
@@ -111,84 +112,6 @@ use std::sync::Mutex;
 pub const NAME: &str = "scene_aware";
 /// Bumped whenever the output for the same input changes (invalidates the cache).
 pub const VERSION: u32 = 36;
-
-/// The scene-aware engine. Holds the report of its last run (see [`SceneAware::last_report`]).
-#[derive(Debug, Default)]
-pub struct SceneAware {
-    last: Mutex<Option<SceneAwareReport>>,
-}
-
-impl SceneAware {
-    pub fn new() -> Self {
-        Self::default()
-    }
-
-    /// The report of the last `decompose` call.
-    pub fn last_report(&self) -> Option<SceneAwareReport> {
-        self.last.lock().ok().and_then(|g| g.clone())
-    }
-
-    /// Decompose a scene and return the hulls with the report.
-    pub fn run(
-        &self,
-        objects: &[&Mesh],
-        opts: &DecomposeOptions,
-    ) -> Result<(Vec<Vec<Hull>>, SceneAwareReport)> {
-        let key = opts
-            .cache_dir
-            .as_ref()
-            .map(|_| cache::key(NAME, VERSION, opts, objects));
-        if let (Some(dir), Some(key)) = (&opts.cache_dir, &key) {
-            if let Some(c) = cache::load(dir, key, NAME, VERSION) {
-                if let (Some(h), Ok(mut r)) = (
-                    cache::hulls(&c),
-                    serde_json::from_value::<SceneAwareReport>(c.report.clone()),
-                ) {
-                    if h.len() == objects.len() {
-                        r.cached = true;
-                        return Ok((h, r));
-                    }
-                }
-            }
-        }
-        let (hulls, report) = decompose_scene(objects, opts);
-        if let (Some(dir), Some(key)) = (&opts.cache_dir, key) {
-            let scene = cache::CachedScene {
-                key,
-                engine: NAME.into(),
-                version: VERSION,
-                objects: hulls
-                    .iter()
-                    .map(|o| o.iter().map(cache::CachedHull::from_hull).collect())
-                    .collect(),
-                report: serde_json::to_value(&report)
-                    .map_err(|e| crate::error::Error::Internal(e.to_string()))?,
-            };
-            cache::store(dir, &scene)?;
-        }
-        Ok((hulls, report))
-    }
-}
-
-impl Decomposer for SceneAware {
-    fn name(&self) -> &'static str {
-        NAME
-    }
-
-    fn decompose(&self, objects: &[&Mesh], opts: &DecomposeOptions) -> Result<Vec<Vec<Hull>>> {
-        let (h, r) = self.run(objects, opts)?;
-        if let Ok(mut g) = self.last.lock() {
-            *g = Some(r);
-        }
-        Ok(h)
-    }
-
-    fn object_warnings(&self) -> Vec<Vec<String>> {
-        self.last_report()
-            .map(|r| r.objects.iter().map(|o| o.warnings()).collect())
-            .unwrap_or_default()
-    }
-}
 
 /// Derived absolute parameters of one object.
 #[derive(Clone, Debug)]
@@ -1691,16 +1614,19 @@ pub fn decompose_scene(
     objects: &[&Mesh],
     opts: &DecomposeOptions,
 ) -> (Vec<Vec<Hull>>, SceneAwareReport) {
-    decompose_scene_with(objects, opts, true)
+    let (hulls, report, _) = decompose_scene_with(objects, opts, true);
+    (hulls, report)
 }
 
 /// [`decompose_scene`]; `spend_rest`: whether [`top_up`] spends what the neighbours left of
 /// each object's budget.
+/// Also returns each object's [`Surface`] (`None` without triangles), for the caller's
+/// fidelity measure to reuse.
 fn decompose_scene_with(
     objects: &[&Mesh],
     opts: &DecomposeOptions,
     spend_rest: bool,
-) -> (Vec<Vec<Hull>>, SceneAwareReport) {
+) -> (Vec<Vec<Hull>>, SceneAwareReport, Vec<Option<Surface>>) {
     let n = objects.len();
     let boxes: Vec<Option<crate::mesh::Aabb>> = objects.iter().map(|m| m.aabb()).collect();
     let near = |a: usize, b: usize| match (&boxes[a], &boxes[b]) {
@@ -1842,12 +1768,13 @@ fn decompose_scene_with(
             }
         }
     }
+    let (reports, surfs) = objs.into_iter().map(|o| (o.report, o.surf)).unzip();
     let report = SceneAwareReport {
-        objects: objs.into_iter().map(|o| o.report).collect(),
+        objects: reports,
         rounds,
         cached: false,
     };
-    (hulls, report)
+    (hulls, report, surfs)
 }
 
 /// Step 3b: spend what the neighbours left of each object's budget. An object next to a

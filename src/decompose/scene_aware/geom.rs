@@ -158,7 +158,28 @@ impl Surface {
     /// matters: on the symmetric basket fixture, distances off by rounding broke ties between
     /// mirrored splits the other way, and the fruits rolled out of the basket in Rapier.
     pub fn farther(&self, p: &P3, r: f64) -> bool {
-        !self.within(p, r * (1.0 - WITHIN_MARGIN)) && self.distance(p) > r
+        !self.within(p, r * (1.0 - WITHIN_MARGIN)) && self.beyond(p, r)
+    }
+
+    /// `distance(p) > r`, exactly, by parry's projection searched only within `r` plus a
+    /// margin (`project_point_with_max_dist`): the BVH prunes every box beyond it, where an
+    /// unbounded search descends to the nearest triangle however far. The projection found
+    /// within the bound is the one the unbounded search finds (the same traversal, less the
+    /// boxes that cannot hold it), so its distance is the same bits; none found within
+    /// `r·(1 + WITHIN_MARGIN)` is farther than `r` whatever the rounding.
+    fn beyond(&self, p: &P3, r: f64) -> bool {
+        let q = to_dvec(p);
+        if !(r > 0.0 && r.is_finite() && q.is_finite()) {
+            return self.distance(p) > r;
+        }
+        let bound = r * (1.0 + WITHIN_MARGIN);
+        match self
+            .tri
+            .project_point_with_max_dist(&Pose::identity(), q, false, bound)
+        {
+            Some(proj) => (crate::mesh::from_dvec(proj.point) - p).norm() > r,
+            None => true,
+        }
     }
 
     /// The largest [`Surface::distance`] of `pts`, exactly: a point within the largest so far
@@ -433,19 +454,26 @@ pub fn farthest_points(pts: &[P3], k: usize) -> Vec<usize> {
     let mut last = first;
     while kept.len() < k {
         let (lx, ly, lz) = (xs[last], ys[last], zs[last]);
+        // Each lane's largest and the chunk of its first occurrence: the first of equals
+        // overall is then the lowest index among the lanes holding the largest, with no
+        // second pass over the distances to find it.
         let mut lanes = [0.0f64; LANES];
-        for (((d, x), y), z) in dist
+        let mut at = [0usize; LANES];
+        for (c, (((d, x), y), z)) in dist
             .chunks_exact_mut(LANES)
             .zip(xs.chunks_exact(LANES))
             .zip(ys.chunks_exact(LANES))
             .zip(zs.chunks_exact(LANES))
+            .enumerate()
         {
             for l in 0..LANES {
                 let (dx, dy, dz) = (x[l] - lx, y[l] - ly, z[l] - lz);
                 let e = dx * dx + dy * dy + dz * dz;
                 let v = if e < d[l] { e } else { d[l] };
                 d[l] = v;
-                lanes[l] = if v > lanes[l] { v } else { lanes[l] };
+                let up = v > lanes[l];
+                lanes[l] = if up { v } else { lanes[l] };
+                at[l] = if up { c } else { at[l] };
             }
         }
         let far = lanes
@@ -454,10 +482,11 @@ pub fn farthest_points(pts: &[P3], k: usize) -> Vec<usize> {
         if far <= 0.0 {
             break;
         }
-        last = dist
-            .iter()
-            .position(|&d| d == far)
-            .expect("far is a distance");
+        last = (0..LANES)
+            .filter(|&l| lanes[l] == far)
+            .map(|l| at[l] * LANES + l)
+            .min()
+            .expect("far is a lane's largest");
         kept.push(last);
     }
     kept

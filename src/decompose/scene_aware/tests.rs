@@ -397,7 +397,7 @@ fn what_the_neighbours_leave_of_the_budget_is_spent() {
     let o = opts();
     let meshes = world_meshes(&sh.join("datasets/scenes/apparel/00004_shoe_tray"));
     let refs: Vec<&Mesh> = meshes.iter().collect();
-    let (kept, r_kept) = decompose_scene_with(&refs, &o, false);
+    let (kept, r_kept, _) = decompose_scene_with(&refs, &o, false);
     let (spent, r_spent) = decompose_scene(&refs, &o);
     let (r0, r1) = (&r_kept.objects[1], &r_spent.objects[1]);
     let left = o.max_hulls - kept[1].len();
