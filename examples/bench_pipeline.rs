@@ -70,6 +70,9 @@ impl Decomposer for Timed {
     fn object_warnings(&self) -> Vec<Vec<String>> {
         self.inner.object_warnings()
     }
+    fn take_surfaces(&self) -> Vec<Option<interact3d::decompose::scene_aware::geom::Surface>> {
+        self.inner.take_surfaces()
+    }
 }
 
 const STAGES: [&str; 6] = [

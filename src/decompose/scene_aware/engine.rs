@@ -19,6 +19,9 @@ pub struct SceneAware {
     surfaces: Mutex<Surfaces>,
 }
 
+/// A run's hulls, report and objects' surfaces.
+type Run = (Vec<Vec<Hull>>, SceneAwareReport, Vec<Option<Surface>>);
+
 /// The surfaces of the last run's objects, in order (empty after a cache hit).
 #[derive(Default)]
 struct Surfaces(Vec<Option<Surface>>);
@@ -51,11 +54,7 @@ impl SceneAware {
 
     /// [`SceneAware::run`], with the objects' surfaces when they were built (not on a cache
     /// hit: empty then).
-    fn run_keeping_surfaces(
-        &self,
-        objects: &[&Mesh],
-        opts: &DecomposeOptions,
-    ) -> Result<(Vec<Vec<Hull>>, SceneAwareReport, Vec<Option<Surface>>)> {
+    fn run_keeping_surfaces(&self, objects: &[&Mesh], opts: &DecomposeOptions) -> Result<Run> {
         let key = opts
             .cache_dir
             .as_ref()

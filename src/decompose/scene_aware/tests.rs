@@ -3,6 +3,7 @@
 
 use super::metrics;
 use super::*;
+use crate::decompose::Decomposer;
 use crate::mesh::{Mesh, P3, V3};
 use crate::shapes;
 use parry3d_f64::math::{Pose, Vector};
