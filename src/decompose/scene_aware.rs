@@ -85,6 +85,7 @@
 //! the result depends on the neighbours.
 
 mod cells;
+mod cover;
 mod fit;
 pub mod geom;
 pub mod metrics;
@@ -110,7 +111,7 @@ use std::sync::Mutex;
 /// Engine name, recorded in reports and in the cache key.
 pub const NAME: &str = "scene_aware";
 /// Bumped whenever the output for the same input changes (invalidates the cache).
-pub const VERSION: u32 = 36;
+pub const VERSION: u32 = 37;
 
 /// The scene-aware engine. Holds the report of its last run (see [`SceneAware::last_report`]).
 #[derive(Debug, Default)]
@@ -1778,6 +1779,13 @@ fn decompose_scene_with(
     let mut rounds = refine(&mut objs, &pairs, &mesh_pen, opts);
     if spend_rest && top_up(&mut objs, &nears, opts) {
         rounds += refine(&mut objs, &pairs, &mesh_pen, opts);
+    }
+    // Mesh surface left deep outside every hull, covered in index order (each object against
+    // its neighbours' hulls as they are then).
+    for k in 0..n {
+        let nbs: Vec<usize> = (0..n).filter(|&b| b != k && near(k, b)).collect();
+        let obstacles = cover::obstacles(&objs, &nbs);
+        objs[k].report.covered = cover::cover(&mut objs[k], &nears[k].0, &obstacles, opts);
     }
     // Final limits and report.
     let mut hulls: Vec<Vec<Hull>> = Vec::with_capacity(n);
