@@ -921,35 +921,11 @@ fn hollow(s: &Surface, parts: &[Part]) -> bool {
 /// diagonal before; now five, exact.
 fn convex_components(s: &Surface, opts: &DecomposeOptions, budget: usize) -> (Vec<Part>, Vec<u32>) {
     let all: Vec<u32> = (0..s.mesh.triangles.len() as u32).collect();
-    // Union-find over vertices, joined through triangles.
-    let mut parent: Vec<u32> = (0..s.mesh.vertices.len() as u32).collect();
-    fn find(parent: &mut [u32], mut x: u32) -> u32 {
-        while parent[x as usize] != x {
-            parent[x as usize] = parent[parent[x as usize] as usize];
-            x = parent[x as usize];
-        }
-        x
-    }
-    for t in &s.mesh.triangles {
-        let a = find(&mut parent, t[0]);
-        for &v in &t[1..] {
-            let b = find(&mut parent, v);
-            if a != b {
-                parent[b as usize] = a;
-            }
-        }
-    }
-    let mut comps: std::collections::BTreeMap<u32, Vec<u32>> = Default::default();
-    for (i, t) in s.mesh.triangles.iter().enumerate() {
-        let r = find(&mut parent, t[0]);
-        comps.entry(r).or_default().push(i as u32);
-    }
+    let comps = geom::components(&s.mesh);
     if comps.len() < 2 {
         return (Vec::new(), all);
     }
     let convex: Vec<Option<Part>> = comps
-        .values()
-        .collect::<Vec<_>>()
         .par_iter()
         .map(|tris| {
             let vs = s.vertices_of(tris);
@@ -988,7 +964,7 @@ fn convex_components(s: &Surface, opts: &DecomposeOptions, budget: usize) -> (Ve
     }
     let mut parts = Vec::with_capacity(n_convex);
     let mut rest = Vec::new();
-    for (c, tris) in convex.into_iter().zip(comps.into_values()) {
+    for (c, tris) in convex.into_iter().zip(comps) {
         match c {
             Some(part) => parts.push(part),
             None => rest.extend(tris),
