@@ -5,14 +5,15 @@
 //!
 //! ```text
 //! cargo run --release --example bench_objects                 # the 43 objects of index.json
-//! cargo run --release --example bench_objects -- --only mug   # ids containing "mug"
+//! cargo run --release --example bench_objects -- --only mug,duplo   # ids containing "mug" or "duplo"
 //! ```
 //!
 //! One row per object: triangles, hulls, wall and CPU seconds (all threads, from
 //! `/proc/self/stat`, 10 ms ticks), the two-sided p95 (`metrics::two_sided_of`, the headline
-//! of `docs/collision_fit.md`), the one-sided p95 and max distance (% of the diagonal) and
-//! the FNV-1a hash of every hull vertex's coordinates (bits, in order). Last: totals, the
-//! worst object beside the mean, and one hash over all objects. Objects are loaded as
+//! of `docs/collision_fit.md`), the outside depth (p99 / max), the one-sided p95 and max
+//! distance (% of the diagonal) and the FNV-1a hash of every hull vertex's coordinates (bits,
+//! in order). Last: totals, the worst object beside the mean (CPU, two-sided p95, outside
+//! p99), and one hash over all objects. Objects are loaded as
 //! `usd_sweep` loads them (the tray at its URDF scale 0.5).
 
 use interact3d::decompose::scene_aware::{metrics, SceneAware};
@@ -63,16 +64,19 @@ fn main() {
     )
     .expect("index.json");
     println!(
-        "| object | triangles | hulls | wall s | CPU s | two-sided p95 % | p95 % | max % | hash |"
+        "| object | triangles | hulls | wall s | CPU s | two-sided p95 % | outside p99 / max % | p95 % | max % | hash |"
     );
-    println!("|---|---:|---:|---:|---:|---:|---:|---:|---|");
+    println!("|---|---:|---:|---:|---:|---:|---|---:|---:|---|");
     let opts = DecomposeOptions::default();
     let (mut wall, mut cpu, mut all) = (0.0, 0.0, FNV_START);
-    // (id, CPU s, two-sided p95)
-    let mut rows: Vec<(String, f64, f64)> = Vec::new();
+    // (id, CPU s, two-sided p95, outside p99)
+    let mut rows: Vec<(String, f64, f64, f64)> = Vec::new();
     for o in index.as_array().expect("a list") {
         let id = o["id"].as_str().unwrap_or("?");
-        if only.as_ref().is_some_and(|w| !id.contains(w.as_str())) {
+        if only
+            .as_ref()
+            .is_some_and(|w| !w.split(',').any(|x| id.contains(x)))
+        {
             continue;
         }
         let mut scale = o["scale_to_m"].as_f64().unwrap_or(1.0);
@@ -98,17 +102,21 @@ fn main() {
         let (w, c) = (t.elapsed().as_secs_f64(), cpu_s() - c);
         let hulls = &sets[0];
         let q = metrics::measure(&m, hulls);
-        let two = metrics::two_sided_of(&m, hulls).map_or(f64::NAN, |t| t.p95);
+        let t2 = metrics::two_sided_of(&m, hulls);
+        let two = t2.map_or(f64::NAN, |t| t.p95);
+        let (out99, out_max) = t2.map_or((f64::NAN, f64::NAN), |t| (t.outside_p99, t.outside_max));
         let h = fnv(FNV_START, hulls);
         all = fnv(all, hulls);
         wall += w;
         cpu += c;
-        rows.push((id.to_string(), c, two));
+        rows.push((id.to_string(), c, two, out99));
         println!(
-            "| {id} | {} | {} | {w:.2} | {c:.2} | {:.3} | {:.3} | {:.3} | {h:016x} |",
+            "| {id} | {} | {} | {w:.2} | {c:.2} | {:.3} | {:.3} / {:.3} | {:.3} | {:.3} | {h:016x} |",
             m.triangles.len(),
             hulls.len(),
             two * 100.0,
+            out99 * 100.0,
+            out_max * 100.0,
             q.dist_p95 * 100.0,
             q.dist_max * 100.0
         );
@@ -120,13 +128,19 @@ fn main() {
         .map(|r| format!("{} {:.2} s", r.0, r.1))
         .unwrap_or_default();
     println!(
-        "\n{} objects: {wall:.1} s wall, {cpu:.1} s CPU (mean {:.2} s, worst {worst}); two-sided p95 mean {:.3} %, worst {}; all hulls {all:016x}",
+        "\n{} objects: {wall:.1} s wall, {cpu:.1} s CPU (mean {:.2} s, worst {worst}); two-sided p95 mean {:.3} %, worst {}; outside p99 mean {:.3} %, worst {}, {} above 0.5 %; all hulls {all:016x}",
         rows.len(),
         cpu / n,
         rows.iter().map(|r| r.2).sum::<f64>() / n * 100.0,
         rows.iter()
             .max_by(|a, b| a.2.total_cmp(&b.2))
             .map(|r| format!("{} {:.3} %", r.0, r.2 * 100.0))
-            .unwrap_or_default()
+            .unwrap_or_default(),
+        rows.iter().map(|r| r.3).sum::<f64>() / n * 100.0,
+        rows.iter()
+            .max_by(|a, b| a.3.total_cmp(&b.3))
+            .map(|r| format!("{} {:.3} %", r.0, r.3 * 100.0))
+            .unwrap_or_default(),
+        rows.iter().filter(|r| r.3 > 0.005).count()
     );
 }

@@ -85,6 +85,7 @@
 //! the result depends on the neighbours.
 
 mod cells;
+mod cover;
 mod engine;
 mod fit;
 pub mod geom;
@@ -111,7 +112,7 @@ use std::sync::Mutex;
 /// Engine name, recorded in reports and in the cache key.
 pub const NAME: &str = "scene_aware";
 /// Bumped whenever the output for the same input changes (invalidates the cache).
-pub const VERSION: u32 = 36;
+pub const VERSION: u32 = 37;
 
 /// Derived absolute parameters of one object.
 #[derive(Clone, Debug)]
@@ -843,35 +844,11 @@ fn hollow(s: &Surface, parts: &[Part]) -> bool {
 /// diagonal before; now five, exact.
 fn convex_components(s: &Surface, opts: &DecomposeOptions, budget: usize) -> (Vec<Part>, Vec<u32>) {
     let all: Vec<u32> = (0..s.mesh.triangles.len() as u32).collect();
-    // Union-find over vertices, joined through triangles.
-    let mut parent: Vec<u32> = (0..s.mesh.vertices.len() as u32).collect();
-    fn find(parent: &mut [u32], mut x: u32) -> u32 {
-        while parent[x as usize] != x {
-            parent[x as usize] = parent[parent[x as usize] as usize];
-            x = parent[x as usize];
-        }
-        x
-    }
-    for t in &s.mesh.triangles {
-        let a = find(&mut parent, t[0]);
-        for &v in &t[1..] {
-            let b = find(&mut parent, v);
-            if a != b {
-                parent[b as usize] = a;
-            }
-        }
-    }
-    let mut comps: std::collections::BTreeMap<u32, Vec<u32>> = Default::default();
-    for (i, t) in s.mesh.triangles.iter().enumerate() {
-        let r = find(&mut parent, t[0]);
-        comps.entry(r).or_default().push(i as u32);
-    }
+    let comps = geom::components(&s.mesh);
     if comps.len() < 2 {
         return (Vec::new(), all);
     }
     let convex: Vec<Option<Part>> = comps
-        .values()
-        .collect::<Vec<_>>()
         .par_iter()
         .map(|tris| {
             let vs = s.vertices_of(tris);
@@ -910,7 +887,7 @@ fn convex_components(s: &Surface, opts: &DecomposeOptions, budget: usize) -> (Ve
     }
     let mut parts = Vec::with_capacity(n_convex);
     let mut rest = Vec::new();
-    for (c, tris) in convex.into_iter().zip(comps.into_values()) {
+    for (c, tris) in convex.into_iter().zip(comps) {
         match c {
             Some(part) => parts.push(part),
             None => rest.extend(tris),
@@ -1704,6 +1681,13 @@ fn decompose_scene_with(
     let mut rounds = refine(&mut objs, &pairs, &mesh_pen, opts);
     if spend_rest && top_up(&mut objs, &nears, opts) {
         rounds += refine(&mut objs, &pairs, &mesh_pen, opts);
+    }
+    // Mesh surface left deep outside every hull, covered in index order (each object against
+    // its neighbours' hulls as they are then).
+    for k in 0..n {
+        let nbs: Vec<usize> = (0..n).filter(|&b| b != k && near(k, b)).collect();
+        let obstacles = cover::obstacles(&objs, &nbs);
+        objs[k].report.covered = cover::cover(&mut objs[k], &nears[k].0, &obstacles, opts);
     }
     // Final limits and report.
     let mut hulls: Vec<Vec<Hull>> = Vec::with_capacity(n);

@@ -278,6 +278,35 @@ impl Surface {
     }
 }
 
+/// The triangles of each connected component of `mesh` (triangles joined through shared
+/// vertices), in the order of their smallest-index root (deterministic), each list ascending.
+pub fn components(mesh: &Mesh) -> Vec<Vec<u32>> {
+    // Union-find over vertices, joined through triangles.
+    let mut parent: Vec<u32> = (0..mesh.vertices.len() as u32).collect();
+    fn find(parent: &mut [u32], mut x: u32) -> u32 {
+        while parent[x as usize] != x {
+            parent[x as usize] = parent[parent[x as usize] as usize];
+            x = parent[x as usize];
+        }
+        x
+    }
+    for t in &mesh.triangles {
+        let a = find(&mut parent, t[0]);
+        for &v in &t[1..] {
+            let b = find(&mut parent, v);
+            if a != b {
+                parent[b as usize] = a;
+            }
+        }
+    }
+    let mut comps: std::collections::BTreeMap<u32, Vec<u32>> = Default::default();
+    for (i, t) in mesh.triangles.iter().enumerate() {
+        let r = find(&mut parent, t[0]);
+        comps.entry(r).or_default().push(i as u32);
+    }
+    comps.into_values().collect()
+}
+
 /// `n` points on a triangle set, stratified by area (deterministic for a given `seed`).
 pub fn sample_triangles(tris: &[[P3; 3]], n: usize, seed: u64) -> Vec<P3> {
     let areas: Vec<f64> = tris.iter().map(triangle_area).collect();

@@ -20,7 +20,7 @@
 //! * **Cavity kept**: for containers (see [`cavity_probe`]), whether the probe point in the
 //!   cavity is outside every hull.
 
-use super::geom::{sample_hull, Surface};
+use super::geom::{components, sample_hull, Surface};
 use crate::decompose::Hull;
 use crate::mesh::{Aabb, Mesh, P3, V3};
 use rayon::prelude::*;
@@ -48,7 +48,7 @@ pub const TWO_SIDED_SAMPLES: usize = 6000;
 pub fn two_sided(s: &Surface, hulls: &[Hull], n: usize) -> Option<TwoSided> {
     let fwd = surface_distances(s, hulls, n);
     let boundary = union_boundary(hulls, s.diag)?;
-    let pts = s.samples(n, 0x5eed);
+    let pts = seen_samples(s, n);
     if fwd.is_empty() || pts.is_empty() {
         return None;
     }
@@ -77,11 +77,48 @@ pub fn two_sided(s: &Surface, hulls: &[Hull], n: usize) -> Option<TwoSided> {
 pub fn mesh_to_hull_distances(s: &Surface, hulls: &[Hull], n: usize) -> Option<Vec<f64>> {
     let boundary = union_boundary(hulls, s.diag)?;
     Some(
-        s.samples(n, 0x5eed)
+        seen_samples(s, n)
             .par_iter()
             .map(|p| boundary.distance(p) / s.diag)
             .collect(),
     )
+}
+
+/// Most closed pieces a mesh is looked at for faces buried in its own material.
+const MAX_PIECES: usize = 64;
+
+/// About `n` points sampled uniformly on the mesh surface, but for those buried in its own
+/// material: a mesh of overlapping closed pieces (the PyBullet tray: six boxes) has faces
+/// inside another of its pieces, which no simulator ever touches, and which lie far from the
+/// boundary of any hulls that fill the material (the tray's exact box hulls read 3.4 % of the
+/// diagonal mesh → hulls at the 95th percentile from those faces alone). A point counts as
+/// buried when strictly inside (by more than 1e-6 of the diagonal) a closed connected piece
+/// of the mesh other than its own. Meshes of one piece, or more than [`MAX_PIECES`], keep
+/// every sample.
+pub fn seen_samples(s: &Surface, n: usize) -> Vec<P3> {
+    let pts = s.samples(n, 0x5eed);
+    let comps = components(&s.mesh);
+    if comps.len() < 2 || comps.len() > MAX_PIECES {
+        return pts;
+    }
+    let pieces: Vec<Surface> = comps
+        .par_iter()
+        .filter_map(|tris| {
+            let vs = s.vertices_of(tris);
+            let local = |v: u32| vs.binary_search(&v).unwrap_or(0) as u32;
+            let m = Mesh::new(
+                vs.iter().map(|&v| s.mesh.vertices[v as usize]).collect(),
+                tris.iter()
+                    .map(|&t| s.mesh.triangles[t as usize].map(local))
+                    .collect(),
+            );
+            Surface::new(&m).filter(|c| c.closed)
+        })
+        .collect();
+    let eps = 1e-6 * s.diag;
+    pts.into_par_iter()
+        .filter(|p| !pieces.iter().any(|c| c.contains(p) && c.distance(p) > eps))
+        .collect()
 }
 
 /// A quick lower estimate of [`mesh_to_hull_distances`] for the engine's choices, without

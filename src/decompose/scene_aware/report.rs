@@ -27,6 +27,10 @@ pub struct ObjectReport {
     /// final (see `refit.rs`).
     #[serde(default)]
     pub refitted: usize,
+    /// Mesh vertices left deep outside every hull that a hull was grown to take in, last
+    /// (see `cover.rs`).
+    #[serde(default)]
+    pub covered: usize,
     /// The patches were found top-down, with plane cuts normal to the scene axes, which
     /// measured closer to the surface than the bottom-up patches (see `Strategy`).
     #[serde(default)]

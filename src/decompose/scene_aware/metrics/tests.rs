@@ -379,3 +379,56 @@ fn the_warning_is_never_silent_above_the_tolerance() {
          closer)"
     );
 }
+
+/// A 100 mm cube and a 100 × 60 × 60 mm bar through its +x face, reaching 50 mm into it:
+/// two overlapping closed pieces in one mesh, as the PyBullet tray's six boxes are.
+fn cube_and_bar() -> (Mesh, Vec<Hull>) {
+    let cube = shapes::cuboid(V3::new(0.1, 0.1, 0.1));
+    let bar = shapes::cuboid(V3::new(0.1, 0.06, 0.06));
+    let bar: Vec<P3> = bar
+        .vertices
+        .iter()
+        .map(|v| v + V3::new(0.05, 0.0, 0.0))
+        .collect();
+    let k = cube.vertices.len() as u32;
+    let mut m = cube.clone();
+    m.vertices.extend(&bar);
+    m.triangles.extend(
+        shapes::cuboid(V3::new(0.1, 0.06, 0.06))
+            .triangles
+            .iter()
+            .map(|t| t.map(|i| i + k)),
+    );
+    let hulls = vec![
+        Hull::from_points(&cube.vertices).unwrap(),
+        Hull::from_points(&bar).unwrap(),
+    ];
+    (m, hulls)
+}
+
+#[test]
+fn faces_buried_in_the_mesh_own_material_are_not_surface() {
+    let (m, hulls) = cube_and_bar();
+    let s = Surface::new(&m).unwrap();
+    // Buried: the middle of the cube's +x face (60 × 60 mm, inside the bar), the bar's -x
+    // end and its four sides over the 50 mm inside the cube: 0.0192 of 0.0912 m².
+    let n = 6000;
+    let seen = seen_samples(&s, n).len() as f64 / n as f64;
+    let expect = 1.0 - 0.0192 / 0.0912;
+    assert!((seen - expect).abs() < 0.015, "{seen} against {expect}");
+    // The exact hulls of the two pieces lie on every face that is seen: 0 both ways.
+    let t = two_sided(&s, &hulls, n).unwrap();
+    assert!(t.mesh_to_hull_p95 < 1e-9, "{t:?}");
+    assert!(t.hull_to_mesh_p95 < 1e-9, "{t:?}");
+    assert_eq!(t.outside_max, 0.0);
+    // Counting the buried faces (21 % of the surface, up to 20 mm from the boundary of the
+    // union), the 95th percentile is past the 1 % tolerance.
+    let all: Vec<f64> = {
+        let b = union_boundary(&hulls, s.diag).unwrap();
+        s.samples(n, 0x5eed)
+            .iter()
+            .map(|p| b.distance(p) / s.diag)
+            .collect()
+    };
+    assert!(percentile(&all, 0.95) > 0.01, "{}", percentile(&all, 0.95));
+}
