@@ -8,7 +8,8 @@
 //!
 //! Run: `nice cargo run --release --example agreement -- [--seeds 0..300] [--out DIR]
 //!       [--objects DIR] [--batch 10] [--keep] [--physx] [--physx-every K] [--only S1,S2]
-//!       [--set KEY=VALUE]` (`--only`: these seeds instead; `--set`: a settle option, for
+//!       [--set KEY=VALUE] [--max-hull-polygons N]` (`--max-hull-polygons 64`: the hulls a user
+//! exporting for Isaac gets, the ones PhysX should judge; `--only`: these seeds instead; `--set`: a settle option, for
 //! experiments; `--physx-every K`:
 //! PhysX judges one batch in K, it is about 4x slower than MuJoCo; the judges' interpreter:
 //! `INTERACT3D_PYTHON`, default `python3`). Objects are decomposed once each and cached in
@@ -30,6 +31,7 @@ fn main() {
     let mut physx_every = 1usize;
     let mut only: Option<Vec<u64>> = None;
     let mut settle = SettleOptions::default();
+    let mut max_polygons = usize::MAX;
     let mut args = std::env::args().skip(1);
     while let Some(a) = args.next() {
         match a.as_str() {
@@ -45,6 +47,16 @@ fn main() {
             "--only" => {
                 let v = args.next().expect("--only S1,S2,...");
                 only = Some(v.split(',').map(|s| s.parse().expect("seed")).collect());
+            }
+            "--max-hull-polygons" => {
+                max_polygons = match args.next().expect("--max-hull-polygons N").parse() {
+                    Ok(0) => usize::MAX,
+                    Ok(n) => n,
+                    Err(_) => {
+                        eprintln!("--max-hull-polygons N (0: no limit)");
+                        std::process::exit(2)
+                    }
+                }
             }
             "--set" => set(&mut settle, &args.next().expect("--set KEY=VALUE")),
             "--physx" => physx = true,
@@ -64,11 +76,16 @@ fn main() {
     let physx_script = scripts.join("agreement_physx.py");
     std::fs::create_dir_all(&out).expect("output folder");
     let t = std::time::Instant::now();
-    let catalog = Catalog::load(&objects, None, Some("target/agreement-cache".into()))
-        .unwrap_or_else(|e| {
-            eprintln!("{e}");
-            std::process::exit(2)
-        });
+    let catalog = Catalog::load_with(
+        &objects,
+        None,
+        Some("target/agreement-cache".into()),
+        max_polygons,
+    )
+    .unwrap_or_else(|e| {
+        eprintln!("{e}");
+        std::process::exit(2)
+    });
     eprintln!(
         "{} objects decomposed in {:.1} s",
         catalog.objects.len(),
@@ -147,6 +164,10 @@ fn set(o: &mut SettleOptions, kv: &str) {
         "angular_damping" => o.angular_damping = x,
         "prediction_distance" => o.prediction_distance = x,
         "contact_recycling" => o.contact_recycling = x != 0.0,
+        "coulomb_friction" => o.coulomb_friction = x != 0.0,
+        "contact_clustering" => o.contact_clustering = x != 0.0,
+        "friction_in_bias_pass" => o.friction_in_bias_pass = x != 0.0,
+        "max_corrective_velocity" => o.max_corrective_velocity = x,
         "contact_recycle_distance" => o.contact_recycle_distance = x,
         "probe_angle_deg" => o.probe_angle_deg = x,
         "probe_time" => o.probe_time = x,
