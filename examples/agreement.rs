@@ -15,7 +15,7 @@
 //! `INTERACT3D_PYTHON`, default `python3`). Objects are decomposed once each and cached in
 //! `target/agreement-cache`.
 
-use interact3d::agreement::{judge, run_scene_with, summary, Catalog, Judged, Summary};
+use interact3d::agreement::{judge::judge_with, run_scene_with, summary, Catalog, Judged, Summary};
 use interact3d::physics::SettleOptions;
 use rayon::prelude::*;
 use std::io::Write;
@@ -113,9 +113,23 @@ fn main() {
                 }
             })
             .collect();
-        let judged = judged_by("MuJoCo", &python, &script, &done, &mut lines);
+        let judged = judged_by(
+            "MuJoCo",
+            &python,
+            &script,
+            &done,
+            &mut lines,
+            settle.settle_max_time,
+        );
         if let Some(px) = px_lines.as_mut().filter(|_| k % physx_every == 0) {
-            all_px.extend(judged_by("PhysX", &python, &physx_script, &done, px));
+            all_px.extend(judged_by(
+                "PhysX",
+                &python,
+                &physx_script,
+                &done,
+                px,
+                settle.settle_max_time,
+            ));
         }
         if !keep {
             for (_, _, d) in &done {
@@ -189,8 +203,9 @@ fn judged_by(
         PathBuf,
     )],
     lines: &mut std::fs::File,
+    settle_s: f64,
 ) -> Vec<Judged> {
-    let judged = judge(engine, python, script, done).unwrap_or_else(|e| {
+    let judged = judge_with(engine, python, script, done, settle_s).unwrap_or_else(|e| {
         eprintln!("{e}");
         std::process::exit(1)
     });

@@ -23,7 +23,7 @@ import time
 import mujoco
 import numpy as np
 
-SETTLE_S = 2.0
+SETTLE_S = float(os.environ.get("AGREEMENT_SETTLE_S", "2.0"))
 REST_S = 1.0
 FROM_SETTLED_S = 2.0
 
@@ -78,7 +78,7 @@ def judge(entry):
 
     reset(model, data, "composed")
     composed = snapshot(data, bodies)
-    _, finite1 = run(model, data, SETTLE_S, bodies, composed)
+    _, finite1 = run(model, data, entry.get("settle_s", SETTLE_S), bodies, composed)
     settle = {b: float(np.linalg.norm(data.xpos[b] - composed[b][0])) for b in bodies}
     turned = {b: data.xquat[b].copy() for b in bodies}
     rest, finite2 = run(model, data, REST_S, bodies, snapshot(data, bodies))

@@ -131,7 +131,7 @@ def judge(entry):
     try:
         r = Run(composed_path)
         composed = dynamic_only(r.poses(), names)
-        _, finite1 = r.run(SETTLE_S, composed)
+        _, finite1 = r.run(entry.get("settle_s", SETTLE_S), composed)
         after = r.poses()
         settle = {p: float(np.linalg.norm(after[p][0] - composed[p][0])) for p in composed}
         rest, finite2 = r.run(REST_S, {p: after[p] for p in composed})
