@@ -8,13 +8,14 @@
 //!
 //! Run: `nice cargo run --release --example agreement -- [--seeds 0..300] [--out DIR]
 //!       [--objects DIR] [--batch 10] [--keep] [--physx] [--physx-every K] [--only S1,S2]
-//!       [--set KEY=VALUE]` (`--only`: these seeds instead; `--set`: a settle option, for
+//!       [--set KEY=VALUE] [--max-hull-polygons N]` (`--max-hull-polygons 64`: the hulls a user
+//! exporting for Isaac gets, the ones PhysX should judge; `--only`: these seeds instead; `--set`: a settle option, for
 //! experiments; `--physx-every K`:
 //! PhysX judges one batch in K, it is about 4x slower than MuJoCo; the judges' interpreter:
 //! `INTERACT3D_PYTHON`, default `python3`). Objects are decomposed once each and cached in
 //! `target/agreement-cache`.
 
-use interact3d::agreement::{judge, run_scene_with, summary, Catalog, Judged, Summary};
+use interact3d::agreement::{judge::judge_with, run_scene_with, summary, Catalog, Judged, Summary};
 use interact3d::physics::SettleOptions;
 use rayon::prelude::*;
 use std::io::Write;
@@ -30,6 +31,7 @@ fn main() {
     let mut physx_every = 1usize;
     let mut only: Option<Vec<u64>> = None;
     let mut settle = SettleOptions::default();
+    let mut max_polygons = usize::MAX;
     let mut args = std::env::args().skip(1);
     while let Some(a) = args.next() {
         match a.as_str() {
@@ -45,6 +47,16 @@ fn main() {
             "--only" => {
                 let v = args.next().expect("--only S1,S2,...");
                 only = Some(v.split(',').map(|s| s.parse().expect("seed")).collect());
+            }
+            "--max-hull-polygons" => {
+                max_polygons = match args.next().expect("--max-hull-polygons N").parse() {
+                    Ok(0) => usize::MAX,
+                    Ok(n) => n,
+                    Err(_) => {
+                        eprintln!("--max-hull-polygons N (0: no limit)");
+                        std::process::exit(2)
+                    }
+                }
             }
             "--set" => set(&mut settle, &args.next().expect("--set KEY=VALUE")),
             "--physx" => physx = true,
@@ -64,11 +76,16 @@ fn main() {
     let physx_script = scripts.join("agreement_physx.py");
     std::fs::create_dir_all(&out).expect("output folder");
     let t = std::time::Instant::now();
-    let catalog = Catalog::load(&objects, None, Some("target/agreement-cache".into()))
-        .unwrap_or_else(|e| {
-            eprintln!("{e}");
-            std::process::exit(2)
-        });
+    let catalog = Catalog::load_with(
+        &objects,
+        None,
+        Some("target/agreement-cache".into()),
+        max_polygons,
+    )
+    .unwrap_or_else(|e| {
+        eprintln!("{e}");
+        std::process::exit(2)
+    });
     eprintln!(
         "{} objects decomposed in {:.1} s",
         catalog.objects.len(),
@@ -96,9 +113,23 @@ fn main() {
                 }
             })
             .collect();
-        let judged = judged_by("MuJoCo", &python, &script, &done, &mut lines);
+        let judged = judged_by(
+            "MuJoCo",
+            &python,
+            &script,
+            &done,
+            &mut lines,
+            settle.settle_max_time,
+        );
         if let Some(px) = px_lines.as_mut().filter(|_| k % physx_every == 0) {
-            all_px.extend(judged_by("PhysX", &python, &physx_script, &done, px));
+            all_px.extend(judged_by(
+                "PhysX",
+                &python,
+                &physx_script,
+                &done,
+                px,
+                settle.settle_max_time,
+            ));
         }
         if !keep {
             for (_, _, d) in &done {
@@ -147,6 +178,10 @@ fn set(o: &mut SettleOptions, kv: &str) {
         "angular_damping" => o.angular_damping = x,
         "prediction_distance" => o.prediction_distance = x,
         "contact_recycling" => o.contact_recycling = x != 0.0,
+        "coulomb_friction" => o.coulomb_friction = x != 0.0,
+        "contact_clustering" => o.contact_clustering = x != 0.0,
+        "friction_in_bias_pass" => o.friction_in_bias_pass = x != 0.0,
+        "max_corrective_velocity" => o.max_corrective_velocity = x,
         "contact_recycle_distance" => o.contact_recycle_distance = x,
         "probe_angle_deg" => o.probe_angle_deg = x,
         "probe_time" => o.probe_time = x,
@@ -168,8 +203,9 @@ fn judged_by(
         PathBuf,
     )],
     lines: &mut std::fs::File,
+    settle_s: f64,
 ) -> Vec<Judged> {
-    let judged = judge(engine, python, script, done).unwrap_or_else(|e| {
+    let judged = judge_with(engine, python, script, done, settle_s).unwrap_or_else(|e| {
         eprintln!("{e}");
         std::process::exit(1)
     });

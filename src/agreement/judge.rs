@@ -3,9 +3,12 @@
 //! the CPU), one process for a batch, and this module compares their answers with ours.
 //!
 //! The engine's scene verdict ([`RULES`]) is the settle test's rule replayed from the composed
-//! pose (MJCF keyframe `composed`; the USD's `customData` composed pose): after 2 s every free
-//! body's centre of mass has moved at most 10 % of its bounding-box diagonal, and over the next
-//! 1 s it moves at most 1 mm and turns at most 1°. The engine's rest answer: from the exported
+//! pose (MJCF keyframe `composed`; the USD's `customData` composed pose): after as long as our
+//! settle phase may take (`SettleOptions::settle_max_time`, 6 s) every free body's centre of
+//! mass has moved at most 10 % of its bounding-box diagonal, and over the next 1 s it moves at
+//! most 1 mm and turns at most 1°. The engine gets the same settle time as Rapier: with 2 s, a
+//! soup can MuJoCo was still rocking and a spoon still sliding into a mug counted as failures
+//! where both come to rest (seeds 83 and 93 of 0..300; docs/agreement.md). The engine's rest answer: from the exported
 //! (settled) pose, every body stays within 1 mm and 1° for 2 s.
 
 use super::{Generated, Ours};
@@ -15,7 +18,7 @@ use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
 /// The engine's verdict rule, as written into the results.
-pub const RULES: &str = "from the composed pose: COM drift <= 10% of the bbox diagonal after 2 s and no turn > 30 deg that moves the shape by > 10% of the diagonal, then <= 1 mm and <= 1 deg over 1 s; rest: <= 1 mm and <= 1 deg for 2 s from the settled pose";
+pub const RULES: &str = "from the composed pose: COM drift <= 10% of the bbox diagonal after the settle cap (6 s) and no turn > 30 deg that moves the shape by > 10% of the diagonal, then <= 1 mm and <= 1 deg over 1 s; rest: <= 1 mm and <= 1 deg for 2 s from the settled pose";
 /// Rest agreement thresholds.
 pub const REST_MM: f64 = 1.0;
 pub const REST_DEG: f64 = 1.0;
@@ -83,6 +86,19 @@ pub fn judge(
     script: &Path,
     scenes: &[(Generated, Ours, PathBuf)],
 ) -> Result<Vec<Judged>> {
+    let settle_s = crate::physics::SettleOptions::default().settle_max_time;
+    judge_with(engine, python, script, scenes, settle_s)
+}
+
+/// [`judge`] with the engine's settle part lasting `settle_s` seconds (our settle cap, when
+/// experiments change it).
+pub fn judge_with(
+    engine: &str,
+    python: &str,
+    script: &Path,
+    scenes: &[(Generated, Ours, PathBuf)],
+    settle_s: f64,
+) -> Result<Vec<Judged>> {
     let list: Vec<serde_json::Value> = scenes
         .iter()
         .map(|(_, o, d)| {
@@ -90,6 +106,7 @@ pub fn judge(
                 "dir": d,
                 "diagonals": o.bodies.iter().map(|b| (b.name.clone(), b.diagonal)).collect::<BTreeMap<_, _>>(),
                 "settled": o.passed,
+                "settle_s": settle_s,
             })
         })
         .collect();

@@ -96,12 +96,26 @@ impl Catalog {
     /// Read `dir/index.json` and decompose each object alone (ids filtered by `keep` when
     /// given). Decompositions are cached in `cache` by content, so a second run costs reading.
     pub fn load(dir: &Path, keep: Option<&[&str]>, cache: Option<PathBuf>) -> Result<Catalog> {
+        Catalog::load_with(dir, keep, cache, usize::MAX)
+    }
+
+    /// [`Catalog::load`] with a polygon budget per hull (`export --max-hull-polygons`;
+    /// `usize::MAX`: none): the hulls a user exporting for Isaac/PhysX gets
+    /// ([`crate::decompose::PHYSX_MAX_POLYGONS`]), so the PhysX judge sees what PhysX cooks as
+    /// written instead of hulls it re-cooks smaller.
+    pub fn load_with(
+        dir: &Path,
+        keep: Option<&[&str]>,
+        cache: Option<PathBuf>,
+        max_polygons: usize,
+    ) -> Result<Catalog> {
         let index = dir.join("index.json");
         let bytes = std::fs::read(&index).map_err(|e| Error::input(&index, e.to_string()))?;
         let entries: Vec<IndexEntry> =
             serde_json::from_slice(&bytes).map_err(|e| Error::input(&index, e.to_string()))?;
         let mut opts = BuildOptions::default();
         opts.decompose.cache_dir = cache;
+        opts.decompose.max_polygons = max_polygons;
         let limits = Limits::default();
         let mut objects = Vec::new();
         let mut decomposer = String::new();

@@ -81,6 +81,20 @@ pub struct SettleOptions {
     pub settle_max_time: f64,
     /// Length of the rest phase (s).
     pub rest_time: f64,
+    /// Rapier's friction model: `true` solves one Coulomb friction constraint per contact
+    /// point (`FrictionModel::Coulomb`, what MuJoCo and PhysX do); `false` is Rapier's default
+    /// `Simplified` model, one friction constraint at the centre of each group of four contact
+    /// points plus a twist constraint.
+    pub coulomb_friction: bool,
+    /// Rapier's contact clustering: manifolds of one collider pair with nearly the same normal
+    /// are merged into one cluster of at most four points before the solver sees them.
+    pub contact_clustering: bool,
+    /// Rapier's `friction_in_bias_pass`: friction also acts while the solver pushes
+    /// interpenetrating contacts apart (its bias pass). Rapier's default is off.
+    pub friction_in_bias_pass: bool,
+    /// Fastest speed (m/s) at which the solver pushes an interpenetration apart (Rapier's
+    /// `max_corrective_velocity`; its default 3 m/s).
+    pub max_corrective_velocity: f64,
     /// Restitution of every collider (floor included).
     pub restitution: f64,
     /// Friction coefficient of the floor (combined with a body's by averaging, Rapier's default).
@@ -167,6 +181,10 @@ impl Default for SettleOptions {
             gravity: 9.81,
             settle_max_time: 6.0,
             rest_time: 1.0,
+            coulomb_friction: false,
+            contact_clustering: true,
+            friction_in_bias_pass: false,
+            max_corrective_velocity: 3.0,
             restitution: 0.0,
             floor_friction: 0.8,
             sleep_linear_threshold: 0.005,

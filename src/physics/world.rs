@@ -2,6 +2,7 @@
 //! contact queries the checks use, and [`rapier_mass_properties`].
 
 use super::*;
+use rapier3d_f64::dynamics::FrictionModel;
 
 /// The mass properties Rapier gives a body built from `body` (for checks and debugging): the
 /// reconstructed inertia tensor about the COM (body-frame axes), the COM and the mass.
@@ -120,6 +121,14 @@ impl<'a> Sim<'a> {
         ip.dt = opts.dt;
         ip.num_solver_iterations = opts.solver_iterations;
         ip.contact_recycling = opts.contact_recycling;
+        ip.contact_clustering = opts.contact_clustering;
+        ip.friction_in_bias_pass = opts.friction_in_bias_pass;
+        ip.normalized_max_corrective_velocity = opts.max_corrective_velocity / ip.length_unit;
+        ip.friction_model = if opts.coulomb_friction {
+            FrictionModel::Coulomb
+        } else {
+            FrictionModel::Simplified
+        };
         ip.normalized_prediction_distance = opts.prediction_distance / ip.length_unit;
         ip.normalized_contact_recycle_distance = opts.contact_recycle_distance / ip.length_unit;
         ip.contact_softness.natural_frequency = opts.contact_frequency;
