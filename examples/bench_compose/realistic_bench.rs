@@ -252,6 +252,16 @@ pub fn run(args: &[String]) {
                                 100.0 * (est.scale / s.truth[n].scale - 1.0),
                                 r.method
                             );
+                            let truth_s = s.truth[n].scale;
+                            for st in &r.stages {
+                                eprintln!(
+                                    "      {:<20} fit {:.3e} scale {:+6.2} % {}",
+                                    st.stage,
+                                    st.fit,
+                                    100.0 * (st.scale / truth_s - 1.0),
+                                    if st.accepted { "taken" } else { "refused" }
+                                );
+                            }
                         }
                         recs.push(Record {
                             pair: k,
