@@ -25,6 +25,7 @@ use interact3d::metrics::{pair_metrics, MetricsOptions, Prepared, Solid};
 use std::path::Path;
 use std::time::Instant;
 
+mod guidance_stats;
 mod realistic_bench;
 
 struct Case {

@@ -111,20 +111,6 @@ impl<'a> Guard<'a> {
         ok
     }
 
-    /// Development: take a pose regardless of its fit.
-    pub fn force(&mut self, stage: &str, t: Similarity) {
-        let f = self.fit(&t);
-        self.log.push(StageFit {
-            stage: stage.to_string(),
-            fit: f,
-            scale: t.scale,
-            accepted: true,
-        });
-        self.best = t;
-        self.best_fit = f;
-        self.stage = stage.to_string();
-    }
-
     pub fn pose(&self) -> Similarity {
         self.best
     }

@@ -30,7 +30,6 @@ pub mod icp;
 pub mod kdtree;
 pub mod obb;
 pub mod occlusion;
-pub mod overlap;
 pub mod plane_icp;
 pub mod realistic;
 pub mod reconstruction;
@@ -398,33 +397,6 @@ fn register(
         let (t, r) = plane_icp::plane_icp(object, &matcher, &g_icp, guard.pose(), &pl);
         if guard.offer("point_to_plane", t) {
             rms = r;
-        }
-        let gprobe = overlap::GuidanceProbe::new(guidance);
-        let probe_gp = guidance.subsample(1000).points;
-        if std::env::var_os("I34_SWEEP").is_some() {
-            eprintln!("    sweep about scale {:.5}", guard.pose().scale);
-            overlap::sweep(&p, &gprobe, spacing, &matcher, &g_icp, guard.pose(), &probe_gp, &probe_o);
-        }
-        if let Ok(mode) = std::env::var("I34_OVERLAP") {
-            let (t, m) = overlap::scale_by_overlap(
-                &p,
-                &gprobe,
-                spacing,
-                &matcher,
-                &g_icp,
-                guard.pose(),
-                &[-0.12, -0.08, -0.04, 0.04, 0.08, 0.12],
-                &probe_gp,
-                &probe_o,
-                icp.scale_lo,
-                icp.scale_hi,
-            );
-            let _ = m;
-            if mode == "2" {
-                guard.force("scale_overlap", t);
-            } else {
-                guard.offer("scale_overlap", t);
-            }
         }
     }
     let t = guard.pose();
