@@ -44,7 +44,7 @@ pub fn measure(inp: &ObjectInput, truth: &Similarity) -> GuidanceStats {
     let uncovered = obj
         .points
         .iter()
-        .filter(|p| gt.nearest(p).map_or(true, |(_, d2)| d2.sqrt() >= tau))
+        .filter(|p| !gt.nearest(p).is_some_and(|(_, d2)| d2.sqrt() < tau))
         .count() as f64
         / obj.len().max(1) as f64;
     let box_ = Obb::of_points(&obj.points);

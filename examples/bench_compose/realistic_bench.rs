@@ -379,7 +379,7 @@ pub fn run(args: &[String]) {
         for r in &rs {
             *stages.entry(r.stage.as_str()).or_default() += 1;
         }
-        let mean = |f: &dyn Fn(&Record) -> f64| rs.iter().map(|r| f(r)).sum::<f64>() / n as f64;
+        let mean = |f: &dyn Fn(&Record) -> f64| rs.iter().map(|&r| f(r)).sum::<f64>() / n as f64;
         println!(
             "| {k} | {id} | {}/{n} | {}/{n} | {:.2} | {:.2} | {:.2} | {:.2} | {:+.2} | {:.1} % | {:.1} % | {:+.2} % | {:.3} | {} |",
             rs.iter().filter(|r| ok2(r)).count(),
