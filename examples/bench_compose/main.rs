@@ -11,6 +11,9 @@
 //! object, success within 2 % ADD-S & 3 % scale and within 5 % & 5 %, per seed; R_volume of each
 //! composed scene (100k points); which stage's pose won; time per pair (compose only, on
 //! `--threads` cores, 1 by default).
+//! Beside each object: how far its guidance part is from the true surface (`guidance_stats`:
+//! outliers, uncovered surface, normal offset, extent ratio), which tells a registration miss from
+//! a part that does not show the object's size.
 //!
 //! cargo run --release --example bench_compose [-- --seeds N] [--seed-offset N] [--threads N]
 //!     [--jobs N] [--only SUBSTRING,...] [-v]
@@ -25,6 +28,7 @@ use interact3d::metrics::{pair_metrics, MetricsOptions, Prepared, Solid};
 use std::path::Path;
 use std::time::Instant;
 
+mod guidance_stats;
 mod realistic_bench;
 
 struct Case {

@@ -10,6 +10,8 @@ use std::collections::BTreeMap;
 use std::path::Path;
 use std::time::Instant;
 
+use super::guidance_stats::{self, GuidanceStats};
+
 /// (support or container, item, spread of the item's position over the support's half
 /// footprint). Every one of the 43 shared objects appears; flat supports: the plate, the
 /// Cardboard package as a board, the tray; box-like items: the printed cereal box and milk
@@ -109,7 +111,10 @@ struct Record {
     id: String,
     add_s: f64,
     scale: f64,
+    /// Signed scale error (estimate / truth − 1).
+    scale_signed: f64,
     stage: String,
+    guidance: GuidanceStats,
 }
 
 struct SceneRecord {
@@ -220,6 +225,12 @@ pub fn run(args: &[String]) {
                             t_gen.elapsed().as_secs_f64()
                         );
                     }
+                    let gstats: Vec<GuidanceStats> = s
+                        .inputs
+                        .iter()
+                        .zip(&s.truth)
+                        .map(|(i, t)| guidance_stats::measure(i, t))
+                        .collect();
                     let o = ComposeOptions {
                         seed,
                         ..Default::default()
@@ -252,6 +263,21 @@ pub fn run(args: &[String]) {
                                 100.0 * (est.scale / s.truth[n].scale - 1.0),
                                 r.method
                             );
+                            let gs = gstats[n];
+                            eprintln!(
+                                "      guidance: {:.1} % outliers, {:.1} % of the object uncovered, offset {:+.2} % of the diagonal, extent ratio {:.3}",
+                                gs.outliers, gs.uncovered, gs.offset, gs.extent_ratio
+                            );
+                            let truth_s = s.truth[n].scale;
+                            for st in &r.stages {
+                                eprintln!(
+                                    "      {:<20} fit {:.3e} scale {:+6.2} % {}",
+                                    st.stage,
+                                    st.fit,
+                                    100.0 * (st.scale / truth_s - 1.0),
+                                    if st.accepted { "taken" } else { "refused" }
+                                );
+                            }
                         }
                         recs.push(Record {
                             pair: k,
@@ -259,7 +285,9 @@ pub fn run(args: &[String]) {
                             id: id.to_string(),
                             add_s: add,
                             scale,
+                            scale_signed: est.scale / s.truth[n].scale - 1.0,
                             stage: r.pose_stage.clone(),
+                            guidance: gstats[n],
                         });
                         placed.push(inp.visual.geometry().transformed(&est.matrix()));
                         truth_placed.push(inp.visual.geometry().transformed(&s.truth[n].matrix()));
@@ -335,8 +363,8 @@ pub fn run(args: &[String]) {
     );
 
     println!("\n#### Per object (over seeds): ADD-S and scale error in % of the object's diagonal / size\n");
-    println!("| pair | object | ≤ 2 % | ≤ 5 % | mean ADD-S | worst ADD-S | mean scale err | worst scale err | winning stages |");
-    println!("|---:|---|---:|---:|---:|---:|---:|---:|---|");
+    println!("| pair | object | ≤ 2 % | ≤ 5 % | mean ADD-S | worst ADD-S | mean scale err | worst scale err | mean signed scale err | guidance outliers | object uncovered | guidance offset | guidance extent ratio | winning stages |");
+    println!("|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---|");
     let mut keys: Vec<(usize, String)> = recs.iter().map(|r| (r.pair, r.id.clone())).collect();
     keys.sort();
     keys.dedup();
@@ -351,14 +379,20 @@ pub fn run(args: &[String]) {
         for r in &rs {
             *stages.entry(r.stage.as_str()).or_default() += 1;
         }
+        let mean = |f: &dyn Fn(&Record) -> f64| rs.iter().map(|&r| f(r)).sum::<f64>() / n as f64;
         println!(
-            "| {k} | {id} | {}/{n} | {}/{n} | {:.2} | {:.2} | {:.2} | {:.2} | {} |",
+            "| {k} | {id} | {}/{n} | {}/{n} | {:.2} | {:.2} | {:.2} | {:.2} | {:+.2} | {:.1} % | {:.1} % | {:+.2} % | {:.3} | {} |",
             rs.iter().filter(|r| ok2(r)).count(),
             rs.iter().filter(|r| ok5(r)).count(),
             100.0 * rs.iter().map(|r| r.add_s).sum::<f64>() / n as f64,
             100.0 * rs.iter().map(|r| r.add_s).fold(0.0, f64::max),
             100.0 * rs.iter().map(|r| r.scale).sum::<f64>() / n as f64,
             100.0 * rs.iter().map(|r| r.scale).fold(0.0, f64::max),
+            100.0 * mean(&|r| r.scale_signed),
+            mean(&|r| r.guidance.outliers),
+            mean(&|r| r.guidance.uncovered),
+            mean(&|r| r.guidance.offset),
+            mean(&|r| r.guidance.extent_ratio),
             stages
                 .iter()
                 .map(|(s, c)| format!("{s} ×{c}"))

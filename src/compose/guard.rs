@@ -19,6 +19,8 @@ pub struct StageFit {
     pub stage: String,
     /// Mean truncated guidance-to-surface distance at the stage's pose (guidance units).
     pub fit: f64,
+    /// The stage pose's scale (object to guidance units).
+    pub scale: f64,
     pub accepted: bool,
 }
 
@@ -71,6 +73,7 @@ impl<'a> Guard<'a> {
         g.log.push(StageFit {
             stage: stage.to_string(),
             fit: g.best_fit,
+            scale: start.scale,
             accepted: true,
         });
         g
@@ -97,6 +100,7 @@ impl<'a> Guard<'a> {
         self.log.push(StageFit {
             stage: stage.to_string(),
             fit: f,
+            scale: t.scale,
             accepted: ok,
         });
         if ok {
