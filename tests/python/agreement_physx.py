@@ -35,7 +35,7 @@ FROM_SETTLED_S = 2.0
 
 # The PhysX driver's helpers (this folder is the script's own, first on sys.path).
 from check_usd import quat_angle_deg as angle_deg
-from check_usd import stdout_to_stderr
+from check_usd import read_rigid_bodies, stdout_to_stderr
 
 
 def wxyz(q):
@@ -81,20 +81,7 @@ class Run:
         self.physx.wait_task(self.physx.attach_ovstage(self.stage, read_ordinal=1))
 
     def poses(self):
-        from ovphysx.types import ObjectScope, SimObjectType
-
-        rows = {}
-        attrs = ["position", "orientation"]
-        with self.physx.read_sync(SimObjectType.RIGID_BODY, attrs, scope=ObjectScope.ALL) as result:
-            paths = result.dictionary
-            for g in result.groups:
-                if g.is_delete or g.is_array or not g.tensors:
-                    continue
-                names = paths.get_path_strings(g.prim_list)
-                attr = paths.token_to_string(g.attribute)
-                vals = g.tensors[0].numpy().copy()
-                for i, p in enumerate(names):
-                    rows.setdefault(p, {})[attr] = np.array(vals[i], dtype=float)
+        rows = read_rigid_bodies(self.physx, ["position", "orientation"])
         return {p: (r["position"], r["orientation"]) for p, r in rows.items() if len(r) == 2}
 
     def run(self, seconds, start):

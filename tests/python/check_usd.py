@@ -157,12 +157,31 @@ def authored_hulls(out):
     return hulls
 
 
+def read_rigid_bodies(physx, attrs):
+    """Every rigid body's attributes `attrs` from a running ovphysx `PhysX`: {prim path: {attr:
+    numpy array}} (shared with agreement_physx.py)."""
+    from ovphysx.types import ObjectScope, SimObjectType
+
+    rows = {}
+    with physx.read_sync(SimObjectType.RIGID_BODY, attrs, scope=ObjectScope.ALL) as result:
+        paths = result.dictionary
+        for g in result.groups:
+            if g.is_delete or g.is_array or not g.tensors:
+                continue
+            names = paths.get_path_strings(g.prim_list)
+            attr = paths.token_to_string(g.attribute)
+            vals = g.tensors[0].numpy().copy()
+            for i, p in enumerate(names):
+                rows.setdefault(p, {})[attr] = np.array(vals[i], dtype=float)
+    return rows
+
+
 def run_physx(out, seconds, dt):
     import ovphysx
     import ovstage
     from ovphysx import PhysX
     from ovphysx.samples.python_samples.schema_support import physx_schema_paths
-    from ovphysx.types import GlobalConfigKey, ObjectScope, SimObjectType
+    from ovphysx.types import GlobalConfigKey, SimObjectType
 
     ovphysx.set_global_config(GlobalConfigKey.NUM_THREADS, 0)
     PhysX.set_cpu_mode(True)
@@ -181,18 +200,10 @@ def run_physx(out, seconds, dt):
     physx.wait_task(physx.attach_ovstage(stage, read_ordinal=1))
 
     def read_bodies(attrs):
-        rows = {}
-        with physx.read_sync(SimObjectType.RIGID_BODY, attrs, scope=ObjectScope.ALL) as result:
-            paths = result.dictionary
-            for g in result.groups:
-                if g.is_delete or g.is_array or not g.tensors:
-                    continue
-                names = paths.get_path_strings(g.prim_list)
-                attr = paths.token_to_string(g.attribute)
-                vals = g.tensors[0].numpy().copy()
-                for i, p in enumerate(names):
-                    rows.setdefault(p, {})[attr] = vals[i].tolist()
-        return rows
+        return {
+            p: {a: v.tolist() for a, v in r.items()}
+            for p, r in read_rigid_bodies(physx, attrs).items()
+        }
 
     def debug_render(settings):
         # One attribute per debug-render write session.
