@@ -29,7 +29,7 @@
 //! * a container's cavity probe (`metrics::cavity_probe`) stays outside every hull, and the
 //!   grown hull keeps `clearance` from every hull of every neighbour.
 
-use super::geom::{greedy_hull, polyhedron, sample_triangles};
+use super::geom::{greedy_hull, polyhedron};
 use super::metrics::cavity_probe;
 use super::rebalance::pinned;
 use super::{geom, Obj};
@@ -188,17 +188,7 @@ fn grown(h: &Hull, v: &P3, max_vertices: usize, slack: f64) -> Option<Hull> {
 /// Whether the faces of `g` around its vertex `v` stand off the mesh by less than `bound`
 /// (sampled; points inside the material within `seam` of the surface not counted).
 fn stands_off(s: &geom::Surface, g: &Hull, v: &P3, seam: f64, bound: f64) -> bool {
-    let Some(k) = g.vertices.iter().position(|x| x == v) else {
-        return false;
-    };
-    let faces: Vec<[P3; 3]> = g
-        .triangles
-        .iter()
-        .filter(|t| t.contains(&(k as u32)))
-        .map(|t| t.map(|i| g.vertices[i as usize]))
-        .collect();
-    let samples = sample_triangles(&faces, FACE_SAMPLES, 0xc0);
-    s.max_distance_until(&samples, seam, bound) < bound
+    super::refit::faces_around_within(s, g, v, (FACE_SAMPLES, 0xc0), seam, bound)
 }
 
 /// Whether `g` keeps `clearance` from every obstacle.

@@ -146,6 +146,20 @@ pub(super) fn grow(
 /// sampled, and not counting points inside the material within the seam depth, as for a wall
 /// segment's [`deviation`]. The other faces are the hull's before `v` was added.
 fn hugs(s: &Surface, p: &Params, g: &Hull, v: &P3) -> bool {
+    faces_around_within(s, g, v, (FACE_SAMPLES, 0x9f), p.seam_depth(), p.tol)
+}
+
+/// Whether the faces of `g` around its vertex `v` lie within `bound` of the mesh: `samples.0`
+/// points sampled on them (seed `samples.1`), points inside the material within `seam` of the
+/// surface not counted. Shared by the refit ([`hugs`]) and the last cover pass.
+pub(super) fn faces_around_within(
+    s: &Surface,
+    g: &Hull,
+    v: &P3,
+    samples: (usize, u64),
+    seam: f64,
+    bound: f64,
+) -> bool {
     let Some(k) = g.vertices.iter().position(|x| x == v) else {
         return false;
     };
@@ -155,6 +169,6 @@ fn hugs(s: &Surface, p: &Params, g: &Hull, v: &P3) -> bool {
         .filter(|t| t.contains(&(k as u32)))
         .map(|t| t.map(|i| g.vertices[i as usize]))
         .collect();
-    let samples = sample_triangles(&faces, FACE_SAMPLES, 0x9f);
-    s.max_distance_until(&samples, p.seam_depth(), p.tol) < p.tol
+    let samples = sample_triangles(&faces, samples.0, samples.1);
+    s.max_distance_until(&samples, seam, bound) < bound
 }
