@@ -19,6 +19,7 @@ struct Node<const D: usize> {
 /// A k-d tree over a fixed set of points.
 #[derive(Clone, Debug)]
 pub struct KdTreeN<const D: usize> {
+    /// The points, in tree order after the build.
     pts: Vec<[f64; D]>,
     idx: Vec<u32>,
     nodes: Vec<Node<D>>,
@@ -76,6 +77,9 @@ impl<const D: usize> KdTreeN<D> {
                 left: 0,
             });
             t.build(0, 0, t.idx.len());
+            // The points in tree order, so a leaf's points are contiguous in memory (`idx`
+            // keeps their original indices).
+            t.pts = t.idx.iter().map(|&i| t.pts[i as usize]).collect();
         }
         t
     }
@@ -132,16 +136,23 @@ impl<const D: usize> KdTreeN<D> {
         }
         let q = *q;
         let mut best = (usize::MAX, f64::INFINITY);
-        let mut stack: Vec<(u32, f64)> = Vec::with_capacity(64);
-        stack.push((0, box_d2(&self.nodes[0], &q)));
-        while let Some((n, bd)) = stack.pop() {
+        // A fixed stack instead of a heap allocation per query (this is the hottest loop of
+        // `compose`): a path holds at most one pending sibling per level, and median splits
+        // of 2^32 points are at most 32 levels deep.
+        let mut stack = [(0u32, 0.0f64); 66];
+        stack[0] = (0, box_d2(&self.nodes[0], &q));
+        let mut top = 1;
+        while top > 0 {
+            top -= 1;
+            let (n, bd) = stack[top];
             if bd >= best.1 {
                 continue;
             }
             let node = &self.nodes[n as usize];
             if node.left == 0 {
-                for &i in &self.idx[node.start as usize..node.end as usize] {
-                    let d = d2(&self.pts[i as usize], &q);
+                let (a, b) = (node.start as usize, node.end as usize);
+                for (&i, p) in self.idx[a..b].iter().zip(&self.pts[a..b]) {
+                    let d = d2(p, &q);
                     if d < best.1 || (d == best.1 && (i as usize) < best.0) {
                         best = (i as usize, d);
                     }
@@ -153,12 +164,13 @@ impl<const D: usize> KdTreeN<D> {
             let dr = box_d2(&self.nodes[l as usize + 1], &q);
             // Push the farther first so the nearer is visited first.
             if dl <= dr {
-                stack.push((l + 1, dr));
-                stack.push((l, dl));
+                stack[top] = (l + 1, dr);
+                stack[top + 1] = (l, dl);
             } else {
-                stack.push((l, dl));
-                stack.push((l + 1, dr));
+                stack[top] = (l, dl);
+                stack[top + 1] = (l + 1, dr);
             }
+            top += 2;
         }
         Some(best)
     }
@@ -178,8 +190,9 @@ impl<const D: usize> KdTreeN<D> {
                 continue;
             }
             if node.left == 0 {
-                for &i in &self.idx[node.start as usize..node.end as usize] {
-                    if d2(&self.pts[i as usize], &q) <= r2 {
+                let (a, b) = (node.start as usize, node.end as usize);
+                for (&i, p) in self.idx[a..b].iter().zip(&self.pts[a..b]) {
+                    if d2(p, &q) <= r2 {
                         out.push(i as usize);
                     }
                 }
