@@ -86,15 +86,9 @@ mod tests {
         Mesh::new(vertices, triangles)
     }
 
-    /// The rebuild path of a cut against a neighbour (`resolve` → [`kept_side`]), on a case
-    /// made for it: the patch is the two boxes' top faces, and with 8 vertices a hull (4
-    /// surface vertices a patch) its hull spans the slab's four corners only, the tile 2.5 mm
-    /// above it. A neighbour's cut keeping z ≥ 10.2 mm leaves nothing of that hull; what the
-    /// cut leaves of the patch is the tile's top, and the rebuilt hull is exactly the tile's
-    /// top pushed into the material by `d_max` (half the tolerance: the tile is 2 mm thick,
-    /// 0.45 × 2 mm is more): x, y ∈ [80, 84] mm, z ∈ [12.5 mm − d_max, 12.5 mm].
-    #[test]
-    fn a_cut_leaving_nothing_of_a_hull_rebuilds_it_from_the_patch_on_the_kept_side() {
+    /// The slab-and-tile case of the two tests below: its surface, options with 8 vertices a
+    /// hull, the top faces (the patch), the part built on them, and the object holding it.
+    fn top_faces_case() -> (Mesh, Surface, DecomposeOptions, Vec<u32>, Part, Obj) {
         let mesh = slab_and_tile();
         let s = Surface::new(&mesh).unwrap();
         let opts = DecomposeOptions {
@@ -105,8 +99,28 @@ mod tests {
         let top: Vec<u32> = (0..mesh.triangles.len() as u32)
             .filter(|&t| s.tri_normal[t as usize].z > 0.99)
             .collect();
-        assert_eq!(top.len(), 4);
         let part = build_part(&s, &p, &opts, top.clone(), Vec::new()).unwrap();
+        let obj = Obj {
+            surf: Surface::new(&mesh),
+            feat: None,
+            params: Some(p),
+            parts: Vec::new(),
+            report: ObjectReport::default(),
+        };
+        (mesh, s, opts, top, part, obj)
+    }
+
+    /// The rebuild path of a cut against a neighbour (`resolve` → [`kept_side`]), on a case
+    /// made for it: the patch is the two boxes' top faces, and with 8 vertices a hull (4
+    /// surface vertices a patch) its hull spans the slab's four corners only, the tile 2.5 mm
+    /// above it. A neighbour's cut keeping z ≥ 10.2 mm leaves nothing of that hull; what the
+    /// cut leaves of the patch is the tile's top, and the rebuilt hull is exactly the tile's
+    /// top pushed into the material by `d_max` (half the tolerance: the tile is 2 mm thick,
+    /// 0.45 × 2 mm is more): x, y ∈ [80, 84] mm, z ∈ [12.5 mm − d_max, 12.5 mm].
+    #[test]
+    fn a_cut_leaving_nothing_of_a_hull_rebuilds_it_from_the_patch_on_the_kept_side() {
+        let (mesh, s, opts, top, part, obj) = top_faces_case();
+        assert_eq!(top.len(), 4);
         // The hull is the slab's top, the tile 2.5 mm above it.
         let tile_top = P3::new(0.084, 0.084, 0.0125);
         let above = part.hull.plane_distance(&tile_top);
@@ -114,13 +128,6 @@ mod tests {
         assert!((outside_depth(&s, &part.hull, &part.tris) - 0.0025).abs() < 1e-9);
         let (n, c) = (-V3::z(), -0.0102);
         assert!(clip(&part.hull, &n, c).is_none(), "the cut leaves nothing");
-        let obj = Obj {
-            surf: Surface::new(&mesh),
-            feat: None,
-            params: Some(Params::new(&s, &opts, Strategy::Patches)),
-            parts: Vec::new(),
-            report: ObjectReport::default(),
-        };
         let q = kept_side(&obj, &part, n, c, &opts).expect("the tile's top is kept");
         let tile_tris: Vec<u32> = top
             .iter()
@@ -146,24 +153,7 @@ mod tests {
     /// rebuilt: the part is dropped.
     #[test]
     fn a_cut_leaving_nothing_of_the_patch_rebuilds_nothing() {
-        let mesh = slab_and_tile();
-        let s = Surface::new(&mesh).unwrap();
-        let opts = DecomposeOptions {
-            max_vertices: 8,
-            ..Default::default()
-        };
-        let p = Params::new(&s, &opts, Strategy::Patches);
-        let top: Vec<u32> = (0..mesh.triangles.len() as u32)
-            .filter(|&t| s.tri_normal[t as usize].z > 0.99)
-            .collect();
-        let part = build_part(&s, &p, &opts, top, Vec::new()).unwrap();
-        let obj = Obj {
-            surf: Surface::new(&mesh),
-            feat: None,
-            params: Some(p),
-            parts: Vec::new(),
-            report: ObjectReport::default(),
-        };
+        let (_, _, opts, _, part, obj) = top_faces_case();
         assert!(kept_side(&obj, &part, -V3::z(), -0.013, &opts).is_none());
     }
 }
