@@ -4,7 +4,9 @@
 //! The modules follow the data through the pipeline:
 //! [`mesh`] (the model) → [`io`] (file formats) → [`scene`] (sample folders and manifests) →
 //! [`prepare`] (metres, Z-up, on the ground) → [`decompose`] (convex hulls) → [`inertia`] →
-//! [`export`] (MJCF, URDF) → [`metrics`] and [`physics`] (validation) → [`render`] (pictures).
+//! [`export`] (MJCF, URDF, USD) → [`metrics`] and [`physics`] (validation) → [`render`] (pictures).
+//! [`pipeline`] runs a scene through them, [`batch`] a dataset; [`cli`] is the command line
+//! (`main.rs` only parses and calls [`cli::run`]).
 
 // `!(x > 0.0)` is written on purpose throughout: unlike `x <= 0.0` it is also true for NaN,
 // so a guard written that way rejects NaN input too.
@@ -15,6 +17,7 @@
 pub mod agreement;
 pub mod batch;
 pub mod body;
+pub mod cli;
 pub mod compose;
 pub mod decompose;
 pub mod error;
