@@ -456,6 +456,13 @@ fn hulls_sharing_an_outer_face_keep_it_on_the_boundary() {
         assert!(t.hull_to_mesh_p95 < 1e-9, "{t:?}");
         assert_eq!(t.outside_max, 0.0);
     }
+    // A mesh 10 mm taller than the halves: its top lies outside them by exactly 10 mm (the
+    // hole over their 100 mm overlap read it as up to √(50² + 10²) = 51 mm before).
+    let tall = boxed([0.0, 0.0, 0.0], [0.2, 0.1, 0.11]);
+    let st = Surface::new(&tall).unwrap();
+    let halves = [hull(0.0, 0.15).unwrap(), hull(0.05, 0.2).unwrap()];
+    let t = two_sided(&st, &halves, 6000).unwrap();
+    assert!((t.outside_max * st.diag - 0.01).abs() < 1e-9, "{t:?}");
     // Two boxes that meet face to face (a seam: opposite faces in one plane) still lose it.
     let seam = vec![hull(0.0, 0.1).unwrap(), hull(0.1, 0.2).unwrap()];
     let b = union_boundary(&seam, s.diag).unwrap();
