@@ -13,8 +13,9 @@
 //! of `docs/collision_fit.md`), the outside depth (p99 / max), the one-sided p95 and max
 //! distance (% of the diagonal) and the FNV-1a hash of every hull vertex's coordinates (bits,
 //! in order). Last: totals, the worst object beside the mean (CPU, two-sided p95, outside
-//! p99), and one hash over all objects. Objects are loaded as
-//! `usd_sweep` loads them (the tray at its URDF scale 0.5).
+//! p99), and one hash over all objects. Objects are loaded as `bench_decompose --shared`
+//! loads them, at their `scale_to_m` (the tray's is its URDF scale 0.5), so the two benches
+//! measure the same meshes.
 
 use interact3d::decompose::scene_aware::{metrics, SceneAware};
 use interact3d::decompose::{DecomposeOptions, Hull};
@@ -79,10 +80,9 @@ fn main() {
         {
             continue;
         }
-        let mut scale = o["scale_to_m"].as_f64().unwrap_or(1.0);
-        if id.contains("tray") {
-            scale *= 0.5;
-        }
+        // `scale_to_m` holds the tray's URDF scale 0.5 already (applying it twice measured
+        // a tray half the size `bench_decompose` measures).
+        let scale = o["scale_to_m"].as_f64().unwrap_or(1.0);
         let path = shared()
             .join("datasets/objects")
             .join(o["mesh"].as_str().unwrap_or(""));

@@ -200,25 +200,37 @@ pub fn percentile(d: &[f64], q: f64) -> f64 {
 /// two hulls share counts as inside where the neighbour's face covers it): what lies beyond
 /// one of the neighbour's face planes is kept as convex polygons, the rest goes. The pieces
 /// are fanned into triangles. Distances to it are exact up to that 1e-6.
+///
+/// Faces of two hulls in the same plane and facing the same way (two overlapping pieces of
+/// one box, a wall and a wedge of it) are outer surface where they coincide: the hull of the
+/// lower index keeps it (see [`shared_face_plane`]). Growing both would remove it from both,
+/// and open a hole in the boundary: the PyBullet tray's 19 hulls, 13 of them overlapping
+/// pieces of its six boxes, read 3.6 % of the diagonal mesh → hulls at the 95th percentile
+/// (8.6 % at most) from such holes alone, where they fill every box exactly.
 pub fn union_boundary(hulls: &[Hull], diag: f64) -> Option<Surface> {
     let eps = 1e-6 * diag;
     let tris: Vec<Vec<[P3; 3]>> = hulls
         .par_iter()
         .enumerate()
         .map(|(i, h)| {
-            let others: Vec<&Hull> = hulls
+            let others: Vec<(usize, &Hull)> = hulls
                 .iter()
                 .enumerate()
                 .filter(|&(j, g)| j != i && g.aabb.intersects(&h.aabb, eps))
-                .map(|(_, g)| g)
                 .collect();
             let mut out = Vec::new();
             for t in &h.triangles {
-                let mut pieces = vec![t.map(|k| h.vertices[k as usize]).to_vec()];
-                for g in &others {
+                let tri = t.map(|k| h.vertices[k as usize]);
+                let mut pieces = vec![tri.to_vec()];
+                for &(j, g) in &others {
+                    let own = if j > i {
+                        shared_face_plane(&tri, g, eps)
+                    } else {
+                        None
+                    };
                     pieces = pieces
                         .into_iter()
-                        .flat_map(|poly| outside_of(poly, g, eps))
+                        .flat_map(|poly| outside_of(poly, g, eps, own))
                         .collect();
                     if pieces.is_empty() {
                         break;
@@ -245,16 +257,32 @@ pub fn union_boundary(hulls: &[Hull], diag: f64) -> Option<Surface> {
     Surface::new(&mesh)
 }
 
+/// The face plane of `g` (its index) that the triangle `tri` lies in (within `eps`) and faces
+/// the same way as, if any: where the two faces coincide, both are outer surface, and only
+/// one of the two hulls may give it up to the other.
+fn shared_face_plane(tri: &[P3; 3], g: &Hull, eps: f64) -> Option<usize> {
+    let n = (tri[1] - tri[0])
+        .cross(&(tri[2] - tri[0]))
+        .try_normalize(0.0)?;
+    g.planes.iter().position(|(m, d)| {
+        m.dot(&n) > 1.0 - 1e-9 && tri.iter().all(|p| (m.dot(&p.coords) - d).abs() <= eps)
+    })
+}
+
 /// The parts of the convex polygon `poly` outside `g` grown by `eps`, as convex polygons
-/// (none when it lies inside; `poly` itself when one face plane has it all beyond).
-fn outside_of(poly: Vec<P3>, g: &Hull, eps: f64) -> Vec<Vec<P3>> {
+/// (none when it lies inside; `poly` itself when one face plane has it all beyond). Face
+/// plane `own` of `g` (one `poly` lies in, see [`shared_face_plane`]) is shrunk by `eps`
+/// instead: `poly` is beyond it, and kept whole.
+fn outside_of(poly: Vec<P3>, g: &Hull, eps: f64, own: Option<usize>) -> Vec<Vec<P3>> {
     let Some(b) = Aabb::of_points(&poly) else {
         return Vec::new();
     };
+    let grow = |k: usize| if own == Some(k) { -eps } else { eps };
     if !g.aabb.intersects(&b, eps)
         || g.planes
             .iter()
-            .any(|(n, d)| poly.iter().all(|p| n.dot(&p.coords) - d > eps))
+            .enumerate()
+            .any(|(k, (n, d))| poly.iter().all(|p| n.dot(&p.coords) - d > grow(k)))
     {
         return vec![poly];
     }
@@ -262,8 +290,8 @@ fn outside_of(poly: Vec<P3>, g: &Hull, eps: f64) -> Vec<Vec<P3>> {
     // polygon less the grown hull.
     let mut out = Vec::new();
     let mut rest = poly;
-    for (n, d) in &g.planes {
-        let off = d + eps;
+    for (k, (n, d)) in g.planes.iter().enumerate() {
+        let off = d + grow(k);
         let beyond = clip_half(&rest, n, off, false);
         if beyond.len() >= 3 {
             out.push(beyond);
@@ -367,7 +395,8 @@ pub fn stats(d: &[f64]) -> (f64, f64, f64) {
 /// the hulls to the mesh surface. A point within 1e-6 of the diagonal of another hull is on a
 /// seam between two hulls, inside the union: CoACD cuts a solid into pieces that meet on their
 /// cut planes, and with 1e-9 rounding left its YCB pear's inner cut faces on the boundary
-/// (p95 5.87 % of the diagonal, 1.80 % as seams).
+/// (p95 5.87 % of the diagonal, 1.80 % as seams). Where two hulls share an outer face (in
+/// one plane, facing the same way), the one of the lower index keeps it.
 pub fn surface_distances(s: &Surface, hulls: &[Hull], n: usize) -> Vec<f64> {
     let areas: Vec<f64> = hulls.iter().map(|h| h.mesh().area()).collect();
     let total: f64 = areas.iter().sum();
@@ -383,15 +412,28 @@ pub fn surface_distances(s: &Surface, hulls: &[Hull], n: usize) -> Vec<f64> {
             sample_hull(h, k, 0xd15 + i as u64)
                 .into_iter()
                 .filter(|p| {
-                    !hulls
-                        .iter()
-                        .enumerate()
-                        .any(|(j, g)| j != i && g.within_planes(p, eps))
+                    !hulls.iter().enumerate().any(|(j, g)| {
+                        j != i
+                            && g.within_planes(p, eps)
+                            && !(j > i && on_shared_face(p, h, g, eps))
+                    })
                 })
                 .map(|p| s.distance(&p) / s.diag)
                 .collect::<Vec<_>>()
         })
         .collect()
+}
+
+/// Whether `p`, on the surface of hull `h`, lies on a face of `g` in the same plane as one of
+/// `h`'s and facing the same way: outer surface of both, which the hull of the lower index
+/// keeps (as [`union_boundary`] does).
+fn on_shared_face(p: &P3, h: &Hull, g: &Hull, eps: f64) -> bool {
+    g.planes.iter().any(|(m, d)| {
+        (m.dot(&p.coords) - d).abs() <= eps
+            && h.planes
+                .iter()
+                .any(|(n, e)| n.dot(m) > 1.0 - 1e-9 && (n.dot(&p.coords) - e).abs() <= eps)
+    })
 }
 
 /// Volume of the union of the hulls by sampling cell centres of a grid with `res` cells along

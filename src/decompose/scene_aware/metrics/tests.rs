@@ -432,3 +432,40 @@ fn faces_buried_in_the_mesh_own_material_are_not_surface() {
     };
     assert!(percentile(&all, 0.95) > 0.01, "{}", percentile(&all, 0.95));
 }
+
+/// A 200 × 100 × 100 mm box under hulls that overlap and share its faces: its two ends each
+/// 150 mm long (overlapping by 100 mm on four shared faces), and the box's own hull twice.
+/// Each set fills the box exactly, so the boundary of the union is the box's surface
+/// (0.1 m², analytic) and every figure is 0. Faces that coincide and face the same way were
+/// dropped from both hulls before (a hole of 0.04 m² under the two halves: up to 50 mm from
+/// the boundary; the whole surface under the duplicate).
+#[test]
+fn hulls_sharing_an_outer_face_keep_it_on_the_boundary() {
+    let m = boxed([0.0, 0.0, 0.0], [0.2, 0.1, 0.1]);
+    let s = Surface::new(&m).unwrap();
+    let hull = |a: f64, b: f64| Hull::from_points(&boxed([a, 0.0, 0.0], [b, 0.1, 0.1]).vertices);
+    let halves = vec![hull(0.0, 0.15).unwrap(), hull(0.05, 0.2).unwrap()];
+    let twice = vec![hull(0.0, 0.2).unwrap(), hull(0.0, 0.2).unwrap()];
+    for hulls in [halves, twice] {
+        let b = union_boundary(&hulls, s.diag).unwrap();
+        // Less, at most, a strip as wide as the 1e-6-diagonal growth round the box (0.4 m).
+        let area: f64 = b.tri_area.iter().sum();
+        assert!((area - 0.1).abs() < 0.41 * 1e-6 * s.diag, "{area}");
+        let t = two_sided(&s, &hulls, 6000).unwrap();
+        assert!(t.mesh_to_hull_p95 < 1e-9, "{t:?}");
+        assert!(t.hull_to_mesh_p95 < 1e-9, "{t:?}");
+        assert_eq!(t.outside_max, 0.0);
+    }
+    // A mesh 10 mm taller than the halves: its top lies outside them by exactly 10 mm (the
+    // hole over their 100 mm overlap read it as up to √(50² + 10²) = 51 mm before).
+    let tall = boxed([0.0, 0.0, 0.0], [0.2, 0.1, 0.11]);
+    let st = Surface::new(&tall).unwrap();
+    let halves = [hull(0.0, 0.15).unwrap(), hull(0.05, 0.2).unwrap()];
+    let t = two_sided(&st, &halves, 6000).unwrap();
+    assert!((t.outside_max * st.diag - 0.01).abs() < 1e-9, "{t:?}");
+    // Two boxes that meet face to face (a seam: opposite faces in one plane) still lose it.
+    let seam = vec![hull(0.0, 0.1).unwrap(), hull(0.1, 0.2).unwrap()];
+    let b = union_boundary(&seam, s.diag).unwrap();
+    let area: f64 = b.tri_area.iter().sum();
+    assert!((area - 0.1).abs() < 0.41 * 1e-6 * s.diag, "{area}");
+}
