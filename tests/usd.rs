@@ -20,7 +20,7 @@ const ISAAC: &[&str] = &["--max-hull-polygons", "64"];
 
 /// How far (m) an authored hull vertex may lie outside the hull PhysX cooked: the known gap
 /// (issue #31 asks 0.1 mm; see `judge`).
-const COOK_GAP: f64 = 2.0 * MM;
+const COOK_GAP: f64 = 0.1 * MM;
 
 fn usd_python() -> String {
     std::env::var("INTERACT3D_USD_PYTHON").unwrap_or_else(|_| python())
@@ -234,8 +234,7 @@ fn judge(scene: &Path, extra: &[&str]) -> (serde_json::Value, serde_json::Value)
         .map(|o| o["hull_count"].as_u64().unwrap())
         .sum();
     assert_eq!(cooked["hulls"].as_u64().unwrap(), hulls, "{what}");
-    // Known gap too: on pen_mug PhysX moves one cooked vertex 0.7 mm off every authored one
-    // (its plane tolerance); the goal is none.
+    // PhysX makes up no vertex of its own.
     assert!(
         f(&cooked["cooked_to_authored_max_m"]) <= COOK_GAP,
         "{what}: PhysX made up vertices: {}",
@@ -243,12 +242,11 @@ fn judge(scene: &Path, extra: &[&str]) -> (serde_json::Value, serde_json::Value)
     );
     let (dev, path) = cooked_deviation(cooked);
     let scene_name = scene.file_name().unwrap().to_string_lossy().to_string();
-    // Known gap (issue #31, open): the goal is 0.1 mm, but PhysX's quickhull skips vertices
-    // within its 0.7 mm plane tolerance of its partial hull, and physx_legal keeps the ones an
-    // object's pieces share (dropping them opened gaps between pieces): measured up to 0.74 mm
-    // on the fixtures, 1.80 mm on 00009_bottle_lunchbox (examples/usd_sweep.rs). Held to 2 mm
-    // here, which still catches the re-cooking the 64-polygon limit removed (8 mm on round
-    // hulls).
+    // Cooked as written: every authored vertex within 0.1 mm of the hull PhysX collides with.
+    // Hull points are written in millimetres (scaled back by xformOp:scale), where PhysX's
+    // plane tolerance is 0.07 % of a hull's size instead of 0.7 mm (src/export/usd.rs); in
+    // metres it skipped vertices up to 1.8 mm out, and past 64 polygons it re-cooks a round
+    // hull up to 8 mm inside.
     let cook_limit = COOK_GAP;
     assert!(
         dev <= cook_limit,
