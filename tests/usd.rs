@@ -339,6 +339,21 @@ fn newton_imports_the_files() {
         hulls + 1,
         "{n}"
     );
+    // Newton collides the hulls at their authored size (it applies the hull Mesh's
+    // xformOp:scale to the millimetre points): the diameters of its mesh shapes equal those
+    // of the authored hulls in metres.
+    let diag = |v: &serde_json::Value| -> Vec<f64> {
+        v.as_array().unwrap().iter().map(|x| x.as_f64().unwrap()).collect()
+    };
+    let (newton, authored) = (
+        diag(&n["scene.usda"]["hull_diameters_m"]),
+        diag(&n["authored_hull_diameters_m"]),
+    );
+    assert_eq!(newton.len() as u64, hulls, "{n}");
+    assert_eq!(authored.len(), newton.len(), "{n}");
+    for (a, b) in authored.iter().zip(&newton) {
+        assert!((a - b).abs() < 1e-6, "Newton hull diameter {b} m, authored {a} m");
+    }
     for o in objects {
         let name = o["name"].as_str().unwrap();
         let one = &n[format!("{name}.usda")];
