@@ -30,8 +30,8 @@ pub struct PhysxLimits {
 /// The margin [`PhysxLimits`] keeps over PhysX's cooking plane tolerance (0.0007 of the length
 /// scale, 0.7 mm in metres): 1 mm. The USD export writes hull points in millimetres (see
 /// `export::usd::HULL_POINTS_PER_METRE`), where PhysX's tolerance is 0.07 % of the hull's
-/// size, so this is now more than needed (a tolerance relative to the hull's size would keep
-/// more of a small round hull; not measured yet).
+/// size, so this is now more than needed (a tolerance relative to the hull's size keeps
+/// more of a small round hull; tried, not landed: docs/usd.md).
 pub const PHYSX_PLANE_TOLERANCE: f64 = 1e-3;
 
 impl Default for PhysxLimits {
