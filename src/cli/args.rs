@@ -262,6 +262,11 @@ pub struct BuildArgs {
     /// round objects, see docs/usd.md).
     #[arg(long, value_name = "N", default_value_t = 0)]
     pub max_hull_polygons: usize,
+    /// Build for one simulator. `isaac`: every hull within PhysX's 64 polygons, so Isaac Sim /
+    /// Isaac Lab (PhysX) collide the hulls as written (what `--max-hull-polygons 64` does; an
+    /// explicit --max-hull-polygons wins). See docs/usd.md for its cost.
+    #[arg(long, value_enum, value_name = "SIM")]
+    pub target: Option<TargetArg>,
     /// V-HACD voxel resolution.
     #[arg(long, default_value_t = 64)]
     pub vhacd_resolution: u32,
@@ -372,6 +377,12 @@ pub struct BatchArgs {
 }
 
 #[derive(Clone, Copy, clap::ValueEnum)]
+pub enum TargetArg {
+    /// Isaac Sim / Isaac Lab (PhysX): hulls within 64 polygons.
+    Isaac,
+}
+
+#[derive(Clone, Copy, clap::ValueEnum)]
 pub enum UpArg {
     Y,
     Z,
@@ -430,9 +441,10 @@ impl BuildArgs {
         o.engine = self.engine;
         o.decompose.max_hulls = self.max_hulls;
         o.decompose.max_vertices = self.max_hull_vertices;
-        o.decompose.max_polygons = match self.max_hull_polygons {
-            0 => usize::MAX,
-            n => n,
+        o.decompose.max_polygons = match (self.max_hull_polygons, self.target) {
+            (0, Some(TargetArg::Isaac)) => crate::decompose::PHYSX_MAX_POLYGONS,
+            (0, None) => usize::MAX,
+            (n, _) => n,
         };
         o.decompose.resolution = self.vhacd_resolution;
         o.decompose.cache_dir = self.decompose_cache.clone();

@@ -28,7 +28,10 @@ pub struct PhysxLimits {
 }
 
 /// The margin [`PhysxLimits`] keeps over PhysX's cooking plane tolerance (0.0007 of the length
-/// scale, 0.7 mm in metres): 1 mm.
+/// scale, 0.7 mm in metres): 1 mm. The USD export writes hull points in millimetres (see
+/// `export::usd::HULL_POINTS_PER_METRE`), where PhysX's tolerance is 0.07 % of the hull's
+/// size, so this is now more than needed (a tolerance relative to the hull's size keeps
+/// more of a small round hull; tried, not landed: docs/usd.md).
 pub const PHYSX_PLANE_TOLERANCE: f64 = 1e-3;
 
 impl Default for PhysxLimits {
@@ -211,7 +214,7 @@ impl Hull {
 
     /// The hull with only the vertices PhysX's cooking keeps: PhysX builds its hull
     /// incrementally and skips every point within its plane tolerance (0.0007 of its length
-    /// scale: 0.7 mm at `metersPerUnit = 1`) of the hull so far, so a vertex that barely bulges
+    /// scale: 0.7 mm for hull points in metres) of the hull so far, so a vertex that barely bulges
     /// out of the others is dropped and the cooked hull differs from the written one (measured:
     /// up to 0.72 mm on bowl wall segments). Here vertices are added farthest first while they
     /// stand more than `tol` out, then any vertex within `tol` of the hull of the others is
@@ -289,8 +292,8 @@ impl Hull {
     /// otherwise, differently, and open gaps between them down to the centre: the YCB golf
     /// ball's star pieces went from a two-sided p95 of 0.2 % of its diagonal to 13 % (the gaps'
     /// walls are exposed surface), though no vertex moved more than 1.4 mm. A pinned vertex
-    /// within PhysX's tolerance may still be skipped by its cooking: the cooked hull then
-    /// stays within that tolerance (0.7 mm) of the written one, along the seam only.
+    /// within PhysX's 0.7 mm (hull points in metres) used to be skipped by its cooking; with
+    /// the millimetre points of the USD export it is not (tests/usd.rs: within 0.1 mm).
     pub fn within_pinned(self, limits: &PhysxLimits, pinned: &dyn Fn(&P3) -> bool) -> Option<Hull> {
         let fits = |h: &Hull| {
             let (p, pv) = h.polygon_stats();

@@ -22,10 +22,10 @@ use crate::mesh::Mesh;
 pub const DEFAULT_MAX_HULLS: usize = 32;
 
 /// PhysX's polygon budget per hull: it re-cooks a hull of more polygons into another shape,
-/// silently (`--max-hull-polygons 64` keeps every hull within it). Not the default: with the
-/// budget in the engine ([`DecomposeOptions::engine_budget`]) it costs +0.08 points of
-/// two-sided p95 on average over the 43 shared objects, but up to +1.1 on small round solids
-/// (docs/usd.md), so it is asked for by those who export for Isaac.
+/// silently (`--target isaac` or `--max-hull-polygons 64` keeps every hull within it). Not
+/// the default: with the budget in the engine ([`DecomposeOptions::engine_budget`]) it costs
+/// +0.08 points of two-sided p95 on average over the 43 shared objects, but up to +1.1 on
+/// small round solids (docs/usd.md), so it is asked for by those who export for Isaac.
 pub const PHYSX_MAX_POLYGONS: usize = 64;
 
 /// Hulls whose [`Hull::sliver_ratio`] is above this are dropped by [`physx_legal`] (unless they

@@ -80,7 +80,7 @@ pub fn write_usd(
         let ctx = object_context(b, fl, prim);
         let text = templates.render(
             "object.usda.j2",
-            minijinja::context! { generator => GENERATOR, b => ctx.clone() },
+            minijinja::context! { generator => GENERATOR, b => ctx.clone(), hull_scale => HULL_SCALE },
         )?;
         crate::fsutil::write(&dir.join(&ctx.file), text.as_bytes())?;
         // The scene needs no mesh data.
@@ -174,12 +174,12 @@ fn object_context(b: &Body, files: &BodyFiles, prim: String) -> ObjectCtx {
         .map(|(k, h)| MeshCtx {
             prim: format!("Hull_{k:02}"),
             material: String::new(),
-            points: points(&h.vertices),
+            points: points(&in_hull_units(&h.vertices)),
             counts: counts(h.triangles.len()),
             indices: indices(&h.triangles),
             normals: String::new(),
             st: None,
-            extent: extent(&h.vertices),
+            extent: extent(&in_hull_units(&h.vertices)),
         })
         .collect();
     let quat = |q: &UnitQuaternion<f64>| tuple(&[q.w, q.i, q.j, q.k]);
@@ -256,6 +256,23 @@ pub fn principal_axes(i: &Matrix3<f64>) -> (Vector3<f64>, UnitQuaternion<f64>) {
         e.eigenvalues[order[2]],
     );
     (d, q)
+}
+
+/// Hull points are written in millimetres, each hull `Mesh` scaled back to metres by
+/// `xformOp:scale` = [`HULL_SCALE`]. PhysX cooks a convex mesh in its own (unscaled) units and
+/// skips every point within its plane tolerance, 0.0007 × max(1, half the box perimeter) in
+/// those units, of the hull built so far; the mesh scale is applied after cooking. In metres
+/// that is 0.7 mm for any household-sized hull, and PhysX silently dropped barely-bulging
+/// vertices (the cooked hull up to 1.8 mm inside the written one, measured with ovphysx). In
+/// millimetres it is 0.07 % of the hull's size (0.05 mm for a 5 cm cube), and ovphysx's
+/// read-back gives every authored vertex back as a cooked one (tests/usd.rs, docs/usd.md).
+pub const HULL_POINTS_PER_METRE: f64 = 1000.0;
+
+/// `xformOp:scale` of every hull `Mesh`: 1 / [`HULL_POINTS_PER_METRE`].
+pub const HULL_SCALE: &str = "(0.001, 0.001, 0.001)";
+
+fn in_hull_units(ps: &[P3]) -> Vec<P3> {
+    ps.iter().map(|p| p * HULL_POINTS_PER_METRE).collect()
 }
 
 fn tuple(v: &[f64]) -> String {

@@ -14,7 +14,8 @@ usage: check_usd.py OUT_DIR [--seconds S] [--dt DT] [--no-physx] [--newton]
   with the authored hull points: every authored hull vertex must be a cooked vertex and the
   other way round (distances in m).
 - "newton" (with --newton): Newton's ModelBuilder.add_usd on scene.usda and on each object file:
-  bodies and shapes it built.
+  bodies and shapes it built, and the diameters of the hulls it collides (scale applied) beside
+  the authored ones (usd-core, world frame).
 """
 import contextlib
 import glob
@@ -318,6 +319,12 @@ def compare_cooked(hulls, cooked):
     }
 
 
+def diameter(pts):
+    """The largest distance between two points (frame-independent)."""
+    d = pts[:, None, :] - pts[None, :, :]
+    return float(np.sqrt(np.max(np.sum(d * d, axis=2))))
+
+
 def run_newton(out):
     import newton
 
@@ -329,11 +336,24 @@ def run_newton(out):
         b.add_usd(path)
         collide = int(newton.ShapeFlags.COLLIDE_SHAPES)
         colliders = sum(1 for fl in b.shape_flags if int(fl) & collide)
+        # The hulls' diameters as Newton will collide them (its mesh vertices times its shape
+        # scale: hull points are written in millimetres with xformOp:scale 0.001), sorted, to
+        # compare with the authored hulls' diameters in metres.
+        sizes = []
+        for i in range(b.shape_count):
+            v = getattr(b.shape_source[i], "vertices", None)
+            if v is None or not int(b.shape_flags[i]) & collide:
+                continue
+            pts = np.asarray(v, dtype=float) * np.array(b.shape_scale[i], dtype=float)
+            sizes.append(diameter(pts))
         res[os.path.basename(path)] = {
             "bodies": int(b.body_count),
             "shapes": int(b.shape_count),
             "collision_shapes": colliders,
+            "hull_diameters_m": sorted(sizes),
         }
+    authored = sorted(diameter(pts) for _, pts in authored_hulls(out))
+    res["authored_hull_diameters_m"] = authored
     return res
 
 
