@@ -150,6 +150,18 @@ pub fn assemble(
     let meshes: Vec<&Mesh> = prepared.objects.iter().map(|o| &o.geometry).collect();
     let mut hull_sets = engine.decompose(&meshes, &dopts.engine_budget())?;
     let legal = crate::decompose::physx_legal(&mut hull_sets, dopts);
+    let mut scene_warnings = prepared.warnings.clone();
+    if dopts.max_polygons > crate::decompose::PHYSX_MAX_POLYGONS {
+        let n = crate::decompose::physx_recooked(&hull_sets);
+        if n > 0 {
+            scene_warnings.push(format!(
+                "{n} of {} hulls have more than {} polygons: PhysX (Isaac Sim/Lab) re-cooks them \
+                 from the USD into other shapes; export with --target isaac to keep every hull as written",
+                hull_sets.iter().map(Vec::len).sum::<usize>(),
+                crate::decompose::PHYSX_MAX_POLYGONS
+            ));
+        }
+    }
     let notes = engine.object_warnings();
     let mut fidelities = fidelities(prepared, &hull_sets, engine.take_surfaces());
     let mut bodies = Vec::with_capacity(prepared.objects.len());
@@ -276,6 +288,6 @@ pub fn assemble(
         bodies,
         decomposer: engine.name().to_string(),
         scene_to_world: prepared.scene_to_world,
-        warnings: prepared.warnings.clone(),
+        warnings: scene_warnings,
     })
 }

@@ -259,6 +259,17 @@ pub fn physx_legal(sets: &mut [Vec<Hull>], opts: &DecomposeOptions) -> Vec<Legal
         .collect()
 }
 
+/// How many hulls PhysX would re-cook: more than [`PHYSX_MAX_POLYGONS`] polygons (counted as
+/// [`Hull::polygons`] does, which errs high) or more vertices than its 255. An export without
+/// a polygon budget writes such hulls into its USD as they are, and PhysX simulates another
+/// shape (`body::assemble` warns with this count).
+pub fn physx_recooked(sets: &[Vec<Hull>]) -> usize {
+    sets.iter()
+        .flatten()
+        .filter(|h| h.vertices.len() > 255 || h.polygons().len() > PHYSX_MAX_POLYGONS)
+        .count()
+}
+
 /// A point's coordinates as bits, to compare points exactly.
 fn key_of(p: &crate::mesh::P3) -> [u64; 3] {
     [p.x.to_bits(), p.y.to_bits(), p.z.to_bits()]
@@ -288,6 +299,21 @@ mod tests {
     use super::*;
     use crate::mesh::P3;
     use crate::shapes;
+
+    /// A box has 6 polygons, a 10 × 16 UV sphere 16·8 quads + 2·16 cap triangles = 160:
+    /// only the sphere is over PhysX's 64, with or without the box beside it.
+    #[test]
+    fn physx_recooked_counts_hulls_over_64_polygons() {
+        let cube = Hull::from_mesh(shapes::cuboid(crate::mesh::V3::new(0.1, 0.2, 0.3))).unwrap();
+        assert_eq!(cube.polygons().len(), 6);
+        let ball = Hull::from_mesh(shapes::uv_sphere(0.05, 10, 16)).unwrap();
+        assert_eq!(ball.polygons().len(), 16 * 8 + 2 * 16);
+        assert_eq!(physx_recooked(&[vec![cube.clone()]]), 0);
+        assert_eq!(
+            physx_recooked(&[vec![cube.clone(), ball.clone()], vec![ball]]),
+            2
+        );
+    }
 
     #[test]
     fn engine_budget_bounds_polygons_by_euler() {
