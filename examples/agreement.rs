@@ -175,6 +175,7 @@ fn set(o: &mut SettleOptions, kv: &str) {
         "sleep_time" => o.sleep_time = x,
         "contact_frequency" => o.contact_frequency = x,
         "static_contact_frequency" => o.static_contact_frequency = x,
+        "contact_damping_ratio" => o.contact_damping_ratio = x,
         "angular_damping" => o.angular_damping = x,
         "prediction_distance" => o.prediction_distance = x,
         "contact_recycling" => o.contact_recycling = x != 0.0,

@@ -278,6 +278,9 @@ pub struct OurBody {
     pub diagonal: f64,
     pub rest_displacement: f64,
     pub rest_rotation_deg: f64,
+    /// Deepest exact contact penetration during our rest phase, which starts from the
+    /// exported (settled) pose (m): what another engine starting there must push out.
+    pub rest_max_penetration: f64,
     pub marginal: bool,
 }
 
@@ -335,6 +338,7 @@ pub fn run_scene_with(
                 diagonal: diagonal(b),
                 rest_displacement: r.map(|r| r.rest_displacement).unwrap_or(0.0),
                 rest_rotation_deg: r.map(|r| r.rest_rotation_deg).unwrap_or(0.0),
+                rest_max_penetration: r.map(|r| r.rest_max_penetration).unwrap_or(0.0),
                 marginal: r.map(|r| r.marginal).unwrap_or(false),
             }
         })

@@ -111,6 +111,11 @@ pub struct SettleOptions {
     /// Natural frequency (Hz) of contacts with fixed bodies and the floor (Rapier: twice the
     /// dynamic one).
     pub static_contact_frequency: f64,
+    /// Damping ratio of both kinds of soft contacts (Rapier's default 10). With a solver
+    /// substep `h = dt / solver_iterations` and `ω = 2π·frequency`, a contact is pushed out at
+    /// `ω / (hω + 2ζ)` per second of depth, so the depth an item rests at under its weight
+    /// shrinks with a smaller ζ.
+    pub contact_damping_ratio: f64,
     /// Linear damping of every dynamic body (1/s).
     pub linear_damping: f64,
     /// Angular damping of every dynamic body (1/s), a crude stand-in for rolling resistance
@@ -191,6 +196,7 @@ impl Default for SettleOptions {
             sleep_time: 0.5,
             contact_frequency: 120.0,
             static_contact_frequency: 240.0,
+            contact_damping_ratio: 10.0,
             linear_damping: 0.0,
             angular_damping: 0.0,
             perturbation_speed: 0.001,

@@ -567,3 +567,65 @@ fn probe_off_reports_nothing() {
     assert!(!r.bodies[0].marginal);
     assert_eq!(r.bodies[0].probe_rotation_deg, 0.0);
 }
+
+/// Depth of the floor contact of a faceted ball resting on its pole vertex (one contact point
+/// whose lever arm is zero, so the constraint's effective mass is the ball's mass), and after
+/// `steps` steps from `start_depth` into the floor.
+fn ball_floor_depth(opts: &SettleOptions, start_depth: f64, steps: usize) -> f64 {
+    let r = 0.03;
+    let ball = sphere_body("ball", r, 0.1, at(0.0, 0.0, r - start_depth));
+    let sim_opts = SettleOptions {
+        perturbation_speed: 0.0,
+        ..opts.clone()
+    };
+    let mut sim = Sim::new(std::slice::from_ref(&ball), &sim_opts).unwrap();
+    for _ in 0..steps {
+        sim.world.step();
+    }
+    sim.penetrations()[0].0
+}
+
+#[test]
+fn contact_rest_depth_scales_as_a_springs_and_damping_sets_the_push_out() {
+    // A soft contact of natural frequency f holds a body's weight at a depth proportional to
+    // g / (2πf)², whatever its damping ratio ζ (a spring's static deflection; Rapier scales the
+    // spring by the constraint's effective mass). Measured: half of g/ω² (2.2 µm at 240 Hz, the
+    // floor's contacts), so micrometres: not the 1 mm of `allowed_linear_error`, which in
+    // Rapier 0.36 is no solver deadzone (issue #33).
+    let depth = |f: f64, zeta: f64| {
+        let opts = SettleOptions {
+            static_contact_frequency: f,
+            contact_damping_ratio: zeta,
+            ..SettleOptions::default()
+        };
+        let d = ball_floor_depth(&opts, 0.0, 240);
+        let w = 2.0 * PI * f;
+        eprintln!(
+            "f {f} Hz, ζ {zeta}: rest depth {d:.3e} m, g/ω² {:.3e} m",
+            9.81 / (w * w)
+        );
+        assert!(d > 0.0 && d <= 9.81 / (w * w), "f {f}, ζ {zeta}: {d:.3e}");
+        d
+    };
+    let (stiff, undamped, soft) = (depth(240.0, 10.0), depth(240.0, 1.0), depth(120.0, 10.0));
+    assert!(
+        (undamped / stiff - 1.0).abs() < 0.1,
+        "{undamped} vs {stiff}"
+    );
+    assert!((soft / stiff / 4.0 - 1.0).abs() < 0.15, "{soft} vs {stiff}");
+    // The damping ratio sets how fast a penetration is pushed out: Rapier corrects a depth d
+    // at ω / (hω + 2ζ) · d per second (h = dt / solver_iterations): 70 /s at ζ = 10 (the
+    // default, 240 Hz), 422 /s at ζ = 1. From 0.3 mm, after two steps (8.3 ms): e^(−0.58) ≈
+    // 0.56 of it left at ζ = 10, e^(−3.5) ≈ 0.03 at ζ = 1.
+    let left = |zeta: f64| {
+        let opts = SettleOptions {
+            contact_damping_ratio: zeta,
+            ..SettleOptions::default()
+        };
+        ball_floor_depth(&opts, 3e-4, 2)
+    };
+    let (slow, fast) = (left(10.0), left(1.0));
+    eprintln!("0.3 mm after 2 steps: ζ 10 {slow:.3e} m, ζ 1 {fast:.3e} m");
+    assert!(slow > 0.1e-3, "{slow}");
+    assert!(slow > 5.0 * fast, "{slow} vs {fast}");
+}

@@ -133,6 +133,8 @@ impl<'a> Sim<'a> {
         ip.normalized_contact_recycle_distance = opts.contact_recycle_distance / ip.length_unit;
         ip.contact_softness.natural_frequency = opts.contact_frequency;
         ip.static_contact_softness.natural_frequency = opts.static_contact_frequency;
+        ip.contact_softness.damping_ratio = opts.contact_damping_ratio;
+        ip.static_contact_softness.damping_ratio = opts.contact_damping_ratio;
 
         let mut names = std::collections::BTreeSet::new();
         let mut scene_extent: f64 = 1.0;
@@ -437,6 +439,7 @@ pub(super) fn validate_options(o: &SettleOptions) -> Result<(), PhysicsError> {
         ("sleep_time", o.sleep_time),
         ("contact_frequency", o.contact_frequency),
         ("static_contact_frequency", o.static_contact_frequency),
+        ("contact_damping_ratio", o.contact_damping_ratio),
         ("linear_damping", o.linear_damping),
         ("prediction_distance", o.prediction_distance),
         ("contact_recycle_distance", o.contact_recycle_distance),
