@@ -265,8 +265,11 @@ pub fn run(args: &[String]) {
                             );
                             let gs = gstats[n];
                             eprintln!(
-                                "      guidance: {:.1} % outliers, {:.1} % of the object uncovered, offset {:+.2} % of the diagonal, extent ratio {:.3}",
-                                gs.outliers, gs.uncovered, gs.offset, gs.extent_ratio
+                                "      guidance: {:.1} % outliers, {:.1} % of the object uncovered, offset {:+.2} % of the diagonal, extent ratio {:.3}; scale/offset corr² {:.3}",
+                                gs.outliers, gs.uncovered, gs.offset, gs.extent_ratio,
+                                interact3d::compose::plane_icp::scale_offset_correlation(
+                                    &interact3d::compose::cloud::Cloud::sample(&inp.visual, 4000, 1)
+                                )
                             );
                             let truth_s = s.truth[n].scale;
                             for st in &r.stages {

@@ -8,7 +8,7 @@
 
 use super::cloud::Cloud;
 use super::kdtree::KdTree;
-use super::plane_icp::surface_fit;
+use super::plane_icp::{offset_fit, surface_fit};
 use crate::mesh::{VisualMesh, P3};
 use crate::pose::Similarity;
 use serde::Serialize;
@@ -22,6 +22,14 @@ pub struct StageFit {
     /// The stage pose's scale (object to guidance units).
     pub scale: f64,
     pub accepted: bool,
+    /// The normal offset taken out of the fit (guidance units; 0 before the guard measures
+    /// offsets, see [`Guard::measure_offsets`]).
+    #[serde(skip_serializing_if = "is_zero")]
+    pub offset: f64,
+}
+
+fn is_zero(x: &f64) -> bool {
+    *x == 0.0
 }
 
 /// Keeps the best-fitting pose of the stages offered to it.
@@ -34,6 +42,9 @@ pub struct Guard<'a> {
     cap_fraction: f64,
     /// A later pose may be worse by this much (guidance units) and still be taken.
     allowance: f64,
+    /// When set, fits take out each pose's own normal offset, up to this fraction of the
+    /// object's diagonal at the pose's scale ([`offset_fit`]).
+    offset_fraction: Option<f64>,
     best: Similarity,
     best_fit: f64,
     stage: String,
@@ -64,6 +75,7 @@ impl<'a> Guard<'a> {
             probe,
             cap_fraction: 0.03,
             allowance: 0.0,
+            offset_fraction: None,
             best: start,
             best_fit: f64::INFINITY,
             stage: stage.to_string(),
@@ -75,14 +87,44 @@ impl<'a> Guard<'a> {
             fit: g.best_fit,
             scale: start.scale,
             accepted: true,
+            offset: 0.0,
         });
         g
     }
 
     /// The fit of pose `t` (lower is better).
     pub fn fit(&self, t: &Similarity) -> f64 {
-        let cap = self.cap_fraction * t.scale * self.object.diagonal();
-        surface_fit(self.object, self.tree, self.spacing, &self.probe, t, cap)
+        self.fit_offset(t).0
+    }
+
+    /// The fit of pose `t` and the normal offset taken out of it (0 unless measuring offsets).
+    fn fit_offset(&self, t: &Similarity) -> (f64, f64) {
+        let diag = t.scale * self.object.diagonal();
+        let cap = self.cap_fraction * diag;
+        match self.offset_fraction {
+            None => (
+                surface_fit(self.object, self.tree, self.spacing, &self.probe, t, cap),
+                0.0,
+            ),
+            Some(f) => offset_fit(
+                self.object,
+                self.tree,
+                self.spacing,
+                &self.probe,
+                t,
+                cap,
+                f * diag,
+            ),
+        }
+    }
+
+    /// From now on every fit, the current pose's included, takes out the pose's own uniform
+    /// normal offset (up to `fraction` of the object's diagonal): a stage that fits an offset
+    /// beside the scale is then judged against the current pose on the same terms.
+    pub fn measure_offsets(&mut self, fraction: f64) -> &mut Self {
+        self.offset_fraction = Some(fraction);
+        self.best_fit = self.fit(&self.best);
+        self
     }
 
     /// Allow the next offers to be worse by `allowance` (guidance units): a stage with another
@@ -95,13 +137,14 @@ impl<'a> Guard<'a> {
     /// Offer stage `stage`'s pose; taken when its fit is not worse than the current pose's (plus
     /// the allowance). Returns whether it was taken.
     pub fn offer(&mut self, stage: &str, t: Similarity) -> bool {
-        let f = self.fit(&t);
+        let (f, offset) = self.fit_offset(&t);
         let ok = f.is_finite() && f <= self.best_fit + self.allowance;
         self.log.push(StageFit {
             stage: stage.to_string(),
             fit: f,
             scale: t.scale,
             accepted: ok,
+            offset,
         });
         if ok {
             self.best = t;

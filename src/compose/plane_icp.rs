@@ -7,6 +7,12 @@
 //!   ([`super::icp`]) stops a little short on noisy guidance (its pairs are sample to sample, so
 //!   the sample spacing and the noise pull the pose), the plane distances let the surface slide
 //!   along itself and go all the way in; the scale comes from how the surfaces overlap.
+//! - [`plane_icp_offset`]: the same fit with a normal offset δ shared by the whole object
+//!   (residual n·(sRx + t − g) + δ): a reconstruction that fattens or erodes the guidance by a
+//!   roughly constant depth then stops reading as scale.
+//! - [`offset_fit`]: the guard's fit with the pose's own best offset taken out.
+//! - [`scale_offset_correlation`]: how far an object's shape lets scale and offset be told
+//!   apart (1 for a sphere or a cube: not at all).
 //! - [`surface_fit`]: the mean truncated distance from guidance points to the posed object's
 //!   surface; the guard in [`super::compose`] keeps a stage's pose only when this does not grow.
 
@@ -31,6 +37,13 @@ pub struct PlaneIcpOptions {
     pub scale_hi: f64,
     /// Stop when a step moves the pairs by less than this (guidance units).
     pub tolerance: f64,
+    /// Fit a normal offset δ (guidance outside the object's surface by δ), |δ| ≤ `offset_max`
+    /// (guidance units).
+    pub offset: bool,
+    pub offset_max: f64,
+    /// Prior on δ: the cost gains `offset_prior × Σw × δ²`, so where scale and offset cannot be
+    /// told apart (a cube about its centre) the scale keeps it and δ stays 0.
+    pub offset_prior: f64,
 }
 
 impl Default for PlaneIcpOptions {
@@ -43,6 +56,9 @@ impl Default for PlaneIcpOptions {
             scale_lo: 0.0,
             scale_hi: f64::INFINITY,
             tolerance: 0.0,
+            offset: false,
+            offset_max: 0.0,
+            offset_prior: 0.05,
         }
     }
 }
@@ -69,7 +85,21 @@ pub fn plane_icp(
     init: Similarity,
     o: &PlaneIcpOptions,
 ) -> (Similarity, f64) {
+    let (t, rms, _) = plane_icp_offset(object, matcher, guidance, init, o);
+    (t, rms)
+}
+
+/// [`plane_icp`] that also returns the normal offset δ it fitted (0 unless `o.offset`): the
+/// guidance lies δ outside the posed object's surface (δ < 0: inside, an eroded part).
+pub fn plane_icp_offset(
+    object: &Cloud,
+    matcher: &Matcher,
+    guidance: &Cloud,
+    init: Similarity,
+    o: &PlaneIcpOptions,
+) -> (Similarity, f64, f64) {
     let mut t = init;
+    let mut delta = 0.0f64;
     let mut rms = f64::INFINITY;
     let n = guidance.len();
     // (point distance², plane residual, guidance index, object index)
@@ -87,7 +117,7 @@ pub fn plane_icp(
                 pairs.push(((p - guidance.points[gi]).norm_squared(), gi, oi));
             }
         }
-        let dof = if o.scale { 7 } else { 6 };
+        let dof = 6 + o.scale as usize + o.offset as usize;
         if pairs.len() < dof + 1 {
             break;
         }
@@ -100,7 +130,7 @@ pub fn plane_icp(
             .map(|&(_, gi, oi)| {
                 let p = m.transform_point(&object.points[oi]);
                 let nrm = t.rotation * object.normals[oi];
-                (p, nrm, nrm.dot(&(p - guidance.points[gi])))
+                (p, nrm, nrm.dot(&(p - guidance.points[gi])) + delta)
             })
             .collect();
         let mut abs: Vec<f64> = rows.iter().map(|r| r.2.abs()).collect();
@@ -115,12 +145,12 @@ pub fn plane_icp(
                 .fold(V3::zeros(), |a, r| a + w(r.2) * r.0.coords)
                 / wsum,
         );
-        let mut h = SMatrix::<f64, 7, 7>::zeros();
-        let mut g = SVector::<f64, 7>::zeros();
+        let mut h = SMatrix::<f64, 8, 8>::zeros();
+        let mut g = SVector::<f64, 8>::zeros();
         for (p, nrm, r) in &rows {
             let d = p - c;
             let a = d.cross(nrm);
-            let j = SVector::<f64, 7>::from_column_slice(&[
+            let j = SVector::<f64, 8>::from_column_slice(&[
                 a.x,
                 a.y,
                 a.z,
@@ -128,6 +158,7 @@ pub fn plane_icp(
                 nrm.y,
                 nrm.z,
                 if o.scale { nrm.dot(&d) } else { 0.0 },
+                if o.offset { 1.0 } else { 0.0 },
             ]);
             let wi = w(*r);
             h += wi * j * j.transpose();
@@ -135,13 +166,22 @@ pub fn plane_icp(
         }
         // Directions the surface does not constrain (a sphere's spin, a plane's slide) stay put:
         // a tiny damping relative to the largest curvature of the problem.
-        let damp = 1e-9 * (0..7).map(|i| h[(i, i)]).fold(0.0, f64::max);
-        for i in 0..7 {
+        let damp = 1e-9 * (0..8).map(|i| h[(i, i)]).fold(0.0, f64::max);
+        for i in 0..8 {
             h[(i, i)] += damp.max(1e-300);
         }
         if !o.scale {
             h[(6, 6)] = 1.0;
             g[6] = 0.0;
+        }
+        if o.offset {
+            // The prior μ·δ² on the offset itself (not on the step).
+            let mu = o.offset_prior * wsum;
+            h[(7, 7)] += mu;
+            g[7] += mu * delta;
+        } else {
+            h[(7, 7)] = 1.0;
+            g[7] = 0.0;
         }
         let Some(chol) = h.cholesky() else {
             break;
@@ -150,6 +190,7 @@ pub fn plane_icp(
         let omega = V3::new(x[0], x[1], x[2]);
         let tau = V3::new(x[3], x[4], x[5]);
         let next = apply(&t, &omega, &tau, x[6], &c, o.scale_lo, o.scale_hi);
+        let next_delta = (delta + x[7]).clamp(-o.offset_max, o.offset_max);
         let nm = next.matrix();
         let moved = kept
             .iter()
@@ -158,13 +199,15 @@ pub fn plane_icp(
                 let p = &object.points[oi];
                 (nm.transform_point(p) - m.transform_point(p)).norm()
             })
-            .fold(0.0, f64::max);
+            .fold(0.0, f64::max)
+            .max((next_delta - delta).abs());
         t = next;
+        delta = next_delta;
         if moved <= o.tolerance {
             break;
         }
     }
-    (t, rms)
+    (t, rms, delta)
 }
 
 /// Mean over `guidance` of the distance to the surface of the object placed by `t`, each
@@ -201,6 +244,102 @@ pub fn surface_fit(
         sum += d.min(cap);
     }
     sum / guidance.len().max(1) as f64
+}
+
+/// [`surface_fit`] with the pose's own normal offset taken out: δ* is the median signed
+/// distance (guidance outside the surface > 0) of the points that pair with a plane within
+/// `cap`, held within ±`offset_max`; each of those points then counts |distance − δ*|. A
+/// guidance part fattened or eroded by a uniform depth fits its object at the true scale as well
+/// as an exact part would, and no longer favours the scale that absorbs the depth. Returns the
+/// fit and δ* (guidance units).
+pub fn offset_fit(
+    object: &Cloud,
+    tree: &KdTree,
+    spacing: f64,
+    guidance: &[P3],
+    t: &Similarity,
+    cap: f64,
+    offset_max: f64,
+) -> (f64, f64) {
+    let Some(inv) = t.matrix().try_inverse() else {
+        return (cap, 0.0);
+    };
+    // (distance, signed along the normal?) per point.
+    let d: Vec<(f64, bool)> = guidance
+        .iter()
+        .map(|q| {
+            let x = inv.transform_point(q);
+            match tree.nearest(&x) {
+                Some((j, d2)) => {
+                    let along = (x - object.points[j]).dot(&object.normals[j]);
+                    let tangential = (d2 - along * along).max(0.0).sqrt();
+                    if tangential < 2.0 * spacing {
+                        (t.scale * along, true)
+                    } else {
+                        (t.scale * d2.sqrt(), false)
+                    }
+                }
+                None => (cap, false),
+            }
+        })
+        .collect();
+    let mut signed: Vec<f64> = d
+        .iter()
+        .filter(|x| x.1 && x.0.abs() < cap)
+        .map(|x| x.0)
+        .collect();
+    let delta = if signed.is_empty() {
+        0.0
+    } else {
+        signed.sort_by(f64::total_cmp);
+        signed[signed.len() / 2].clamp(-offset_max, offset_max)
+    };
+    let sum: f64 = d
+        .iter()
+        .map(|&(v, plane)| if plane { (v - delta).abs() } else { v }.min(cap))
+        .sum();
+    (sum / guidance.len().max(1) as f64, delta)
+}
+
+/// The squared correlation of the scale and offset estimates of a point-to-plane fit on the
+/// whole of `object`'s surface (samples with normals), rotation and translation free: 1 where
+/// a scale change and a uniform normal offset move the surface alike (a sphere, a cube about its
+/// centre), lower the more the support distances n·(p − c) vary over the surface (an elongated
+/// box ≈ 0.8, a hollow part with inner walls lower). A property of the shape alone.
+pub fn scale_offset_correlation(object: &Cloud) -> f64 {
+    let n = object.points.len().max(1) as f64;
+    let c = P3::from(object.points.iter().fold(V3::zeros(), |a, p| a + p.coords) / n);
+    let mut h = SMatrix::<f64, 8, 8>::zeros();
+    for (p, nrm) in object.points.iter().zip(&object.normals) {
+        let d = p - c;
+        let a = d.cross(nrm);
+        let j = SVector::<f64, 8>::from_column_slice(&[
+            a.x,
+            a.y,
+            a.z,
+            nrm.x,
+            nrm.y,
+            nrm.z,
+            nrm.dot(&d),
+            1.0,
+        ]);
+        h += j * j.transpose();
+    }
+    let damp = 1e-9 * (0..8).map(|i| h[(i, i)]).fold(0.0, f64::max);
+    for i in 0..8 {
+        h[(i, i)] += damp.max(1e-300);
+    }
+    match h.try_inverse() {
+        Some(cov) => {
+            let v = cov[(6, 6)] * cov[(7, 7)];
+            if v > 0.0 {
+                (cov[(6, 7)] * cov[(6, 7)] / v).min(1.0)
+            } else {
+                1.0
+            }
+        }
+        None => 1.0,
+    }
 }
 
 #[cfg(test)]
@@ -282,6 +421,84 @@ mod tests {
     #[test]
     fn point_to_plane_recovers_a_cylinder_motion_and_scale_to_1e_6() {
         recovers(crate::shapes::cylinder(0.3, 1.0, 48), true, true);
+    }
+
+    /// Analytic case for the offset: the guidance is a box's samples pushed out along their
+    /// normals by δ = 1 % of the diagonal (a fattened reconstruction), then moved by a known
+    /// similarity. A box fattened by δ has half-extents a + δ, so a similarity alone must read a
+    /// wrong scale (checked: > 2 % off); the offset fit must return the true scale to 1e-4 and
+    /// δ to 1 %; the guard's `offset_fit` must measure δ and prefer the true pose.
+    #[test]
+    fn offset_fit_separates_a_fattened_part_from_scale() {
+        let obj = sampled(&crate::shapes::cuboid(V3::new(1.0, 0.6, 0.3)), 4000);
+        let diag = obj.diagonal();
+        let delta = 0.01 * diag;
+        let truth = Similarity {
+            scale: 1.3,
+            rotation: UnitQuaternion::from_euler_angles(0.7, -0.4, 1.1),
+            translation: V3::new(0.3, -0.8, 1.7),
+        };
+        let mut fat = sampled(&crate::shapes::cuboid(V3::new(1.0, 0.6, 0.3)), 2500);
+        for (p, n) in fat.points.iter_mut().zip(&fat.normals) {
+            *p += n * delta;
+        }
+        let g = fat.transformed(&truth.matrix());
+        let tree = KdTree::new(&obj.points);
+        let base = PlaneIcpOptions {
+            iterations: 100,
+            keep: 0.9,
+            scale_lo: 0.5,
+            scale_hi: 2.0,
+            tolerance: 1e-12,
+            ..Default::default()
+        };
+        let (plain, _) = plane_icp(&obj, &Matcher::Geometry(&tree), &g, truth, &base);
+        assert!(
+            (plain.scale / truth.scale - 1.0).abs() > 0.02,
+            "premise: a similarity alone reads the fattening as scale ({})",
+            plain.scale / truth.scale
+        );
+        let start = Similarity {
+            scale: truth.scale * 1.05,
+            ..truth
+        };
+        let o = PlaneIcpOptions {
+            offset: true,
+            offset_max: 0.05 * truth.scale * diag,
+            offset_prior: 0.0,
+            ..base
+        };
+        let (t, _, d) = plane_icp_offset(&obj, &Matcher::Geometry(&tree), &g, start, &o);
+        assert!(
+            (t.scale / truth.scale - 1.0).abs() < 1e-3,
+            "scale {}",
+            t.scale / truth.scale
+        );
+        let want = delta * truth.scale;
+        assert!((d / want - 1.0).abs() < 0.05, "offset {d} vs {want}");
+        let spacing = (2.0 * (0.6 + 0.3 + 0.18) / 4000.0f64).sqrt();
+        let cap = 0.03 * truth.scale * diag;
+        let (f_true, d_true) = offset_fit(&obj, &tree, spacing, &g.points, &truth, cap, cap);
+        let (f_plain, _) = offset_fit(&obj, &tree, spacing, &g.points, &plain, cap, cap);
+        assert!(
+            (d_true / want - 1.0).abs() < 0.1,
+            "guard offset {d_true} vs {want}"
+        );
+        assert!(f_true < f_plain, "{f_true} vs {f_plain}");
+    }
+
+    /// Analytic values: a cube about its centre cannot tell scale from offset (n·(p − c) is the
+    /// half-side on every face: 1); a 1 × 0.6 × 0.3 box has support distances 0.5, 0.3, 0.15
+    /// over face areas 0.36, 0.6, 1.2 (each ×2), so corr² = E[x]²/E[x²] = 0.25²/0.0792 = 0.789.
+    #[test]
+    fn scale_offset_correlation_matches_the_support_distances() {
+        let cube = sampled(&crate::shapes::cuboid(V3::new(1.0, 1.0, 1.0)), 6000);
+        let box_ = sampled(&crate::shapes::cuboid(V3::new(1.0, 0.6, 0.3)), 6000);
+        let c = scale_offset_correlation(&cube);
+        let b = scale_offset_correlation(&box_);
+        assert!(c > 0.99, "cube {c}");
+        let want = 0.25f64.powi(2) / ((0.09 + 0.054 + 0.027) / 2.16);
+        assert!((b - want).abs() < 0.02, "box {b} vs {want}");
     }
 
     #[test]
