@@ -23,6 +23,7 @@
 use super::geom::{components, sample_hull, Surface};
 use crate::decompose::Hull;
 use crate::mesh::{Aabb, Mesh, P3, V3};
+use pieces::Pieces;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
@@ -219,31 +220,17 @@ pub fn union_boundary(hulls: &[Hull], diag: f64) -> Option<Surface> {
                 .filter(|&(j, g)| j != i && g.aabb.intersects(&h.aabb, eps))
                 .collect();
             let mut out = Vec::new();
+            let mut pieces = Pieces::default();
             for t in &h.triangles {
                 let tri = t.map(|k| h.vertices[k as usize]);
-                let mut pieces = vec![tri.to_vec()];
-                for &(j, g) in &others {
-                    let own = if j > i {
-                        shared_face_plane(&tri, g, eps)
-                    } else {
-                        None
-                    };
-                    pieces = pieces
-                        .into_iter()
-                        .flat_map(|poly| outside_of(poly, g, eps, own))
-                        .collect();
-                    if pieces.is_empty() {
-                        break;
-                    }
-                }
-                for poly in pieces {
+                pieces.outside(tri, &others, i, eps, |poly| {
                     for k in 1..poly.len() - 1 {
                         let tri = [poly[0], poly[k], poly[k + 1]];
                         if (tri[1] - tri[0]).cross(&(tri[2] - tri[0])).norm() > 0.0 {
                             out.push(tri);
                         }
                     }
-                }
+                });
             }
             out
         })
@@ -255,79 +242,6 @@ pub fn union_boundary(hulls: &[Hull], diag: f64) -> Option<Surface> {
         mesh.triangles.push([k, k + 1, k + 2]);
     }
     Surface::new(&mesh)
-}
-
-/// The face plane of `g` (its index) that the triangle `tri` lies in (within `eps`) and faces
-/// the same way as, if any: where the two faces coincide, both are outer surface, and only
-/// one of the two hulls may give it up to the other.
-fn shared_face_plane(tri: &[P3; 3], g: &Hull, eps: f64) -> Option<usize> {
-    let n = (tri[1] - tri[0])
-        .cross(&(tri[2] - tri[0]))
-        .try_normalize(0.0)?;
-    g.planes.iter().position(|(m, d)| {
-        m.dot(&n) > 1.0 - 1e-9 && tri.iter().all(|p| (m.dot(&p.coords) - d).abs() <= eps)
-    })
-}
-
-/// The parts of the convex polygon `poly` outside `g` grown by `eps`, as convex polygons
-/// (none when it lies inside; `poly` itself when one face plane has it all beyond). Face
-/// plane `own` of `g` (one `poly` lies in, see [`shared_face_plane`]) is shrunk by `eps`
-/// instead: `poly` is beyond it, and kept whole.
-fn outside_of(poly: Vec<P3>, g: &Hull, eps: f64, own: Option<usize>) -> Vec<Vec<P3>> {
-    let Some(b) = Aabb::of_points(&poly) else {
-        return Vec::new();
-    };
-    let grow = |k: usize| if own == Some(k) { -eps } else { eps };
-    if !g.aabb.intersects(&b, eps)
-        || g.planes
-            .iter()
-            .enumerate()
-            .any(|(k, (n, d))| poly.iter().all(|p| n.dot(&p.coords) - d > grow(k)))
-    {
-        return vec![poly];
-    }
-    // Beyond plane k and within the planes before it: disjoint pieces whose union is the
-    // polygon less the grown hull.
-    let mut out = Vec::new();
-    let mut rest = poly;
-    for (k, (n, d)) in g.planes.iter().enumerate() {
-        let off = d + grow(k);
-        let beyond = clip_half(&rest, n, off, false);
-        if beyond.len() >= 3 {
-            out.push(beyond);
-        }
-        rest = clip_half(&rest, n, off, true);
-        if rest.len() < 3 {
-            break;
-        }
-    }
-    out
-}
-
-/// Sutherland–Hodgman: the part of the convex polygon `poly` with `n·x <= off` (`below`) or
-/// `n·x >= off`.
-fn clip_half(poly: &[P3], n: &V3, off: f64, below: bool) -> Vec<P3> {
-    let side = |p: &P3| {
-        let s = n.dot(&p.coords) - off;
-        if below {
-            -s
-        } else {
-            s
-        }
-    };
-    let mut out = Vec::with_capacity(poly.len() + 1);
-    for k in 0..poly.len() {
-        let (a, b) = (poly[k], poly[(k + 1) % poly.len()]);
-        let (sa, sb) = (side(&a), side(&b));
-        if sa >= 0.0 {
-            out.push(a);
-        }
-        if (sa >= 0.0) != (sb >= 0.0) {
-            let t = sa / (sa - sb);
-            out.push(a + (b - a) * t);
-        }
-    }
-    out
 }
 
 /// Measured quality of a set of hulls for one mesh.
@@ -513,5 +427,6 @@ pub fn cavity_probe(s: &Surface) -> Option<P3> {
     Some(p)
 }
 
+mod pieces;
 #[cfg(test)]
 mod tests;
