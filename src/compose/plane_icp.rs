@@ -148,18 +148,7 @@ pub fn plane_icp_offset(
         let mut h = SMatrix::<f64, 8, 8>::zeros();
         let mut g = SVector::<f64, 8>::zeros();
         for (p, nrm, r) in &rows {
-            let d = p - c;
-            let a = d.cross(nrm);
-            let j = SVector::<f64, 8>::from_column_slice(&[
-                a.x,
-                a.y,
-                a.z,
-                nrm.x,
-                nrm.y,
-                nrm.z,
-                if o.scale { nrm.dot(&d) } else { 0.0 },
-                if o.offset { 1.0 } else { 0.0 },
-            ]);
+            let j = jacobian_row(p - c, nrm, o.scale, o.offset);
             let wi = w(*r);
             h += wi * j * j.transpose();
             g += wi * *r * j;
@@ -301,6 +290,23 @@ pub fn offset_fit(
     (sum / guidance.len().max(1) as f64, delta)
 }
 
+/// One point's row of the point-to-plane Jacobian about the centroid, `d = p − c`: rotation
+/// (d × n), translation (n), scale (n·d, or 0 when scale is held) and normal offset (1, or 0
+/// when it is held).
+fn jacobian_row(d: V3, nrm: &V3, scale: bool, offset: bool) -> SVector<f64, 8> {
+    let a = d.cross(nrm);
+    SVector::<f64, 8>::from_column_slice(&[
+        a.x,
+        a.y,
+        a.z,
+        nrm.x,
+        nrm.y,
+        nrm.z,
+        if scale { nrm.dot(&d) } else { 0.0 },
+        if offset { 1.0 } else { 0.0 },
+    ])
+}
+
 /// The squared correlation of the scale and offset estimates of a point-to-plane fit on the
 /// whole of `object`'s surface (samples with normals), rotation and translation free: 1 where
 /// a scale change and a uniform normal offset move the surface alike (a sphere, a cube about its
@@ -311,18 +317,7 @@ pub fn scale_offset_correlation(object: &Cloud) -> f64 {
     let c = P3::from(object.points.iter().fold(V3::zeros(), |a, p| a + p.coords) / n);
     let mut h = SMatrix::<f64, 8, 8>::zeros();
     for (p, nrm) in object.points.iter().zip(&object.normals) {
-        let d = p - c;
-        let a = d.cross(nrm);
-        let j = SVector::<f64, 8>::from_column_slice(&[
-            a.x,
-            a.y,
-            a.z,
-            nrm.x,
-            nrm.y,
-            nrm.z,
-            nrm.dot(&d),
-            1.0,
-        ]);
+        let j = jacobian_row(p - c, nrm, true, true);
         h += j * j.transpose();
     }
     let damp = 1e-9 * (0..8).map(|i| h[(i, i)]).fold(0.0, f64::max);
