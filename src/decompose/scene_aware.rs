@@ -139,7 +139,7 @@ use std::sync::Mutex;
 /// Engine name, recorded in reports and in the cache key.
 pub const NAME: &str = "scene_aware";
 /// Bumped whenever the output for the same input changes (invalidates the cache).
-pub const VERSION: u32 = 37;
+pub const VERSION: u32 = 38;
 
 #[cfg(test)]
 mod tests;
