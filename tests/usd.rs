@@ -243,8 +243,8 @@ fn judge(scene: &Path, extra: &[&str]) -> (serde_json::Value, serde_json::Value)
     );
     let (dev, path) = cooked_deviation(cooked);
     // Cooked as written: every authored vertex within 0.1 mm of the hull PhysX collides with.
-    // Hull points are written in millimetres (scaled back by xformOp:scale), where PhysX's
-    // plane tolerance is 0.07 % of a hull's size instead of 0.7 mm (src/export/usd.rs); in
+    // Hull points are written in decimetres (scaled back by xformOp:scale), where PhysX's
+    // plane tolerance is 0.07 mm instead of 0.7 mm (src/export/usd.rs); in
     // metres it skipped vertices up to 1.8 mm out, and past 64 polygons it re-cooks a round
     // hull up to 8 mm inside.
     let cook_limit = COOK_GAP;
@@ -340,7 +340,7 @@ fn newton_imports_the_files() {
         "{n}"
     );
     // Newton collides the hulls at their authored size (it applies the hull Mesh's
-    // xformOp:scale to the millimetre points): the diameters of its mesh shapes equal those
+    // xformOp:scale to the decimetre points): the diameters of its mesh shapes equal those
     // of the authored hulls in metres.
     let diag = |v: &serde_json::Value| -> Vec<f64> {
         v.as_array()

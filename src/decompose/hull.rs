@@ -28,9 +28,9 @@ pub struct PhysxLimits {
 }
 
 /// The margin [`PhysxLimits`] keeps over PhysX's cooking plane tolerance (0.0007 of the length
-/// scale, 0.7 mm in metres): 1 mm. The USD export writes hull points in millimetres (see
-/// `export::usd::HULL_POINTS_PER_METRE`), where PhysX's tolerance is 0.07 % of the hull's
-/// size, so this is now more than needed (a tolerance relative to the hull's size keeps
+/// scale, 0.7 mm in metres): 1 mm. The USD export writes hull points in decimetres (see
+/// `export::usd::HULL_POINTS_PER_METRE`), where PhysX's tolerance is 0.07 mm (0.07 % of the
+/// hull's size above 10 cm of half perimeter), so this is now more than needed (a tolerance relative to the hull's size keeps
 /// more of a small round hull; tried, not landed: docs/usd.md).
 pub const PHYSX_PLANE_TOLERANCE: f64 = 1e-3;
 
@@ -293,7 +293,7 @@ impl Hull {
     /// ball's star pieces went from a two-sided p95 of 0.2 % of its diagonal to 13 % (the gaps'
     /// walls are exposed surface), though no vertex moved more than 1.4 mm. A pinned vertex
     /// within PhysX's 0.7 mm (hull points in metres) used to be skipped by its cooking; with
-    /// the millimetre points of the USD export it is not (tests/usd.rs: within 0.1 mm).
+    /// the decimetre points of the USD export it is not (tests/usd.rs: within 0.1 mm).
     pub fn within_pinned(self, limits: &PhysxLimits, pinned: &dyn Fn(&P3) -> bool) -> Option<Hull> {
         let fits = |h: &Hull| {
             let (p, pv) = h.polygon_stats();

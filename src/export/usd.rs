@@ -258,18 +258,21 @@ pub fn principal_axes(i: &Matrix3<f64>) -> (Vector3<f64>, UnitQuaternion<f64>) {
     (d, q)
 }
 
-/// Hull points are written in millimetres, each hull `Mesh` scaled back to metres by
+/// Hull points are written in decimetres, each hull `Mesh` scaled back to metres by
 /// `xformOp:scale` = [`HULL_SCALE`]. PhysX cooks a convex mesh in its own (unscaled) units and
 /// skips every point within its plane tolerance, 0.0007 × max(1, half the box perimeter) in
 /// those units, of the hull built so far; the mesh scale is applied after cooking. In metres
 /// that is 0.7 mm for any household-sized hull, and PhysX silently dropped barely-bulging
 /// vertices (the cooked hull up to 1.8 mm inside the written one, measured with ovphysx). In
-/// millimetres it is 0.07 % of the hull's size (0.05 mm for a 5 cm cube), and ovphysx's
-/// read-back gives every authored vertex back as a cooked one (tests/usd.rs, docs/usd.md).
-pub const HULL_POINTS_PER_METRE: f64 = 1000.0;
+/// decimetres it is 0.07 mm, or 0.07 % of the hull's size above 10 cm of half perimeter, and
+/// ovphysx's read-back gives every authored vertex back within 0.07 mm (tests/usd.rs holds
+/// 0.1 mm). Millimetres (scale 0.001) cooked exactly too, but PhysX's contact with a convex
+/// mesh depends on the mesh scale: at 0.001 and 0.01 it rocked a box at rest that it holds at
+/// 1 and 0.1 (docs/usd.md, docs/agreement.md).
+pub const HULL_POINTS_PER_METRE: f64 = 10.0;
 
 /// `xformOp:scale` of every hull `Mesh`: 1 / [`HULL_POINTS_PER_METRE`].
-pub const HULL_SCALE: &str = "(0.001, 0.001, 0.001)";
+pub const HULL_SCALE: &str = "(0.1, 0.1, 0.1)";
 
 fn in_hull_units(ps: &[P3]) -> Vec<P3> {
     ps.iter().map(|p| p * HULL_POINTS_PER_METRE).collect()

@@ -337,7 +337,7 @@ def run_newton(out):
         collide = int(newton.ShapeFlags.COLLIDE_SHAPES)
         colliders = sum(1 for fl in b.shape_flags if int(fl) & collide)
         # The hulls' diameters as Newton will collide them (its mesh vertices times its shape
-        # scale: hull points are written in millimetres with xformOp:scale 0.001), sorted, to
+        # scale: hull points are written in decimetres with xformOp:scale 0.1), sorted, to
         # compare with the authored hulls' diameters in metres.
         sizes = []
         for i in range(b.shape_count):
