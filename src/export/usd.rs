@@ -80,7 +80,7 @@ pub fn write_usd(
         let ctx = object_context(b, fl, prim);
         let text = templates.render(
             "object.usda.j2",
-            minijinja::context! { generator => GENERATOR, b => ctx.clone(), hull_scale => HULL_SCALE },
+            minijinja::context! { generator => GENERATOR, b => ctx.clone(), hull_scale => hull_scale() },
         )?;
         crate::fsutil::write(&dir.join(&ctx.file), text.as_bytes())?;
         // The scene needs no mesh data.
@@ -259,7 +259,7 @@ pub fn principal_axes(i: &Matrix3<f64>) -> (Vector3<f64>, UnitQuaternion<f64>) {
 }
 
 /// Hull points are written in decimetres, each hull `Mesh` scaled back to metres by
-/// `xformOp:scale` = [`HULL_SCALE`]. PhysX cooks a convex mesh in its own (unscaled) units and
+/// `xformOp:scale` = [`hull_scale`]. PhysX cooks a convex mesh in its own (unscaled) units and
 /// skips every point within its plane tolerance, 0.0007 × max(1, half the box perimeter) in
 /// those units, of the hull built so far; the mesh scale is applied after cooking. In metres
 /// that is 0.7 mm for any household-sized hull, and PhysX silently dropped barely-bulging
@@ -271,8 +271,12 @@ pub fn principal_axes(i: &Matrix3<f64>) -> (Vector3<f64>, UnitQuaternion<f64>) {
 /// 1 and 0.1 (docs/usd.md, docs/agreement.md).
 pub const HULL_POINTS_PER_METRE: f64 = 10.0;
 
-/// `xformOp:scale` of every hull `Mesh`: 1 / [`HULL_POINTS_PER_METRE`].
-pub const HULL_SCALE: &str = "(0.1, 0.1, 0.1)";
+/// `xformOp:scale` of every hull `Mesh`, `(0.1, 0.1, 0.1)`: 1 / [`HULL_POINTS_PER_METRE`],
+/// derived so that the two cannot disagree.
+pub fn hull_scale() -> String {
+    let s = 1.0 / HULL_POINTS_PER_METRE;
+    format!("({s}, {s}, {s})")
+}
 
 fn in_hull_units(ps: &[P3]) -> Vec<P3> {
     ps.iter().map(|p| p * HULL_POINTS_PER_METRE).collect()
