@@ -42,7 +42,10 @@
 //! exactly where it is unreliable.
 //!
 //! ## Inside-ness of a hull set
-//! Inside any hull, by face-plane tests `n·p <= d` in f64 (no tolerance).
+//! Inside any hull, by face-plane tests `n·p <= d` in f64 (no tolerance). A grid of cells over
+//! the set, resolved once per object, answers most points without any plane test and leaves the
+//! rest the few planes that cross their cell; the answers are the direct test's bit for bit
+//! (see `hullgrid.rs` for why).
 //!
 //! # R_surface
 //! Area of the triangles of A and of B that intersect (closed test: touching counts) some
@@ -69,6 +72,7 @@
 
 mod bvh;
 mod geom;
+mod hullgrid;
 mod inside;
 #[cfg(test)]
 mod tests;
@@ -81,6 +85,7 @@ use bvh::{Bb, Bvh};
 /// fixtures' gaps with it.
 pub use geom::tri_tri_dist2;
 use geom::V;
+use hullgrid::HullGrid;
 use inside::{Hull, RayMesh};
 use rayon::prelude::*;
 use serde::Serialize;
@@ -98,7 +103,9 @@ pub enum Solid<'a> {
 #[allow(clippy::large_enum_variant)]
 enum Shape {
     Mesh(RayMesh),
-    Hulls(Vec<Hull>),
+    /// The hulls, and the grid that answers their inside test (none for a box that is not
+    /// finite).
+    Hulls(Vec<Hull>, Option<HullGrid>),
 }
 
 /// An object with its acceleration structures, built once and reused for every pair.
@@ -135,7 +142,7 @@ impl Prepared {
             Solid::Hulls(hs) => {
                 let mut soup = Vec::new();
                 let mut verts = Vec::new();
-                let hulls = hs
+                let hulls: Vec<Hull> = hs
                     .iter()
                     .filter(|h| !h.triangles.is_empty())
                     .map(|h| {
@@ -153,7 +160,8 @@ impl Prepared {
                         })
                 });
                 verts.dedup();
-                Prepared::finish(Shape::Hulls(hulls), soup, verts)
+                let grid = HullGrid::new(&hulls);
+                Prepared::finish(Shape::Hulls(hulls, grid), soup, verts)
             }
         }
     }
@@ -205,7 +213,8 @@ impl Prepared {
         }
         match &self.shape {
             Shape::Mesh(m) => m.contains(p),
-            Shape::Hulls(hs) => hs.iter().any(|h| h.contains(p)),
+            Shape::Hulls(hs, Some(g)) => g.contains(hs, p),
+            Shape::Hulls(hs, None) => hs.iter().any(|h| h.contains(p)),
         }
     }
 
@@ -220,7 +229,7 @@ impl Prepared {
                 let (d2, t) = self.surface.nearest(p, hint);
                 (d2.sqrt(), Some(t))
             }
-            Shape::Hulls(hs) => (
+            Shape::Hulls(hs, _) => (
                 hs.iter()
                     .filter(|h| h.contains(p))
                     .map(|h| h.depth(p))
@@ -468,12 +477,17 @@ fn classify_column(
                 *o = m.classify(p, axis, line, other);
             }
         }
-        Shape::Hulls(hs) => {
-            // Only the hulls whose box the column passes through can hold its points: the
-            // others fail `Hull::contains`'s box test on the column's two fixed coordinates
-            // whatever `t`. Same answers, for a fraction of the box tests (a body of 32
-            // hulls is crossed by a few): validation of `00002_fruit_bowl` spent 26 % of its
-            // time in this loop.
+        Shape::Hulls(hs, Some(g)) => {
+            // Each cell of the grid is resolved once (inside, outside, or the few plane tests
+            // its points still need): the same answers as testing every hull, see `hullgrid`.
+            for (o, &t) in out.iter_mut().zip(ts) {
+                let mut p = base;
+                p[axis] = t;
+                *o = g.contains(hs, p);
+            }
+        }
+        Shape::Hulls(hs, None) => {
+            // Only the hulls whose box the column passes through can hold its points.
             let crossed: Vec<&Hull> = hs
                 .iter()
                 .filter(|h| {
@@ -481,9 +495,6 @@ fn classify_column(
                         .all(|&k| h.bb.min[k] <= base[k] && base[k] <= h.bb.max[k])
                 })
                 .collect();
-            if crossed.is_empty() {
-                return;
-            }
             for (o, &t) in out.iter_mut().zip(ts) {
                 let mut p = base;
                 p[axis] = t;
@@ -688,7 +699,7 @@ pub fn max_penetration_depth(a: &Prepared, b: &Prepared, opts: &MetricsOptions) 
     if !a.bb.overlaps(&b.bb) {
         return 0.0;
     }
-    if let (Shape::Hulls(ha), Shape::Hulls(hb)) = (&a.shape, &b.shape) {
+    if let (Shape::Hulls(ha, _), Shape::Hulls(hb, _)) = (&a.shape, &b.shape) {
         let pairs: Vec<(usize, usize)> = (0..ha.len())
             .flat_map(|i| (0..hb.len()).map(move |j| (i, j)))
             .filter(|&(i, j)| ha[i].bb.overlaps(&hb[j].bb))
