@@ -3,7 +3,8 @@
 //! points still need. The answers are those of `hulls.iter().any(|h| h.contains(p))` bit for
 //! bit, not approximately.
 //!
-//! Entry points: [`HullGrid::new`], [`HullGrid::contains`].
+//! Entry points: [`HullGrid::new`], [`HullGrid::contains`], and for the points of one
+//! axis-parallel column [`HullGrid::column`] then [`HullGrid::contains_in`].
 //!
 //! # Why the answers are the same
 //! [`Hull::contains`] is `bb.contains(p) && planes.all(|(n, d)| dot(n, p) <= d)` in f64. A cell
@@ -21,20 +22,26 @@
 //! that range. The tests `any` and `all` do not depend on order, so the grid may test the kept
 //! planes in any order. A grid whose box is not finite is not built (the caller tests every
 //! hull).
+//!
+//! Cells are resolved in blocks of 2×2×2: a block's verdict on a plane holds for its cells
+//! (their widened boxes lie in the block's), so a cell only looks at the planes that cross its
+//! block, and cells of a block outside a hull are not looked at.
 
 use super::bvh::Bb;
 use super::geom::{self, V};
 use super::inside::Hull;
 
-/// Cells of the grid, about; shaped like the box. Resolving a cell costs one pass over the
+/// Blocks of the grid, about; shaped like the box. Resolving a block costs one pass over the
 /// planes of each hull whose box it meets, so this bounds the preparation.
-const TARGET_CELLS: f64 = 8192.0;
+const TARGET_BLOCKS: f64 = 8192.0;
+/// Cells per block along each axis with an extent.
+const SUB: usize = 2;
 
 /// What the points of one cell still need: the hull's box test (unless the cell is inside
-/// it) and its planes `planes[start..end]` (copies, contiguous per cell).
+/// that box) and the planes `planes[start..end]` (copies, contiguous per cell).
 #[derive(Clone, Debug)]
 struct Entry {
-    hull: u32,
+    bb: Bb,
     check_bb: bool,
     start: u32,
     end: u32,
@@ -44,6 +51,8 @@ struct Entry {
 pub struct HullGrid {
     bb: Bb,
     dims: [usize; 3],
+    /// Index step of one cell along each axis.
+    stride: [usize; 3],
     inv_cell: [f64; 3],
     /// Every point of the cell is inside some hull.
     inside: Vec<bool>,
@@ -51,6 +60,28 @@ pub struct HullGrid {
     first: Vec<u32>,
     entries: Vec<Entry>,
     planes: Vec<(V, f64)>,
+}
+
+/// The cells of one column: the index of its first cell and the axis it runs along.
+#[derive(Clone, Copy, Debug)]
+pub struct Column {
+    axis: usize,
+    offset: usize,
+}
+
+/// A box's verdict on a face plane `n·p <= d`, with the margin `m`: every point of the box
+/// passes (`Some(true)`), every point fails (`Some(false)`), or undecided.
+#[inline]
+fn box_vs_plane(cen: V, half: V, n: V, d: f64, m: f64) -> Option<bool> {
+    let mid = geom::dot(n, cen);
+    let r = n[0].abs() * half[0] + n[1].abs() * half[1] + n[2].abs() * half[2];
+    if mid - r > d + m {
+        Some(false)
+    } else if mid + r <= d - m {
+        Some(true)
+    } else {
+        None
+    }
 }
 
 impl HullGrid {
@@ -71,21 +102,23 @@ impl HullGrid {
             .chain(&bb.max)
             .fold(0.0f64, |s, x| s.max(x.abs()));
         let m = 1e-9 * (1.0 + scale);
-        // Cells shaped like the box: side = (volume / target)^(1/3), flat axes one cell.
+        // Blocks shaped like the box: side = (volume / target)^(1/3), flat axes one cell.
         let live: Vec<f64> = ext.iter().copied().filter(|&e| e > 0.0).collect();
         let side = if live.is_empty() {
             1.0
         } else {
             let vol: f64 = live.iter().product();
-            (vol / TARGET_CELLS).powf(1.0 / live.len() as f64)
+            (vol / TARGET_BLOCKS).powf(1.0 / live.len() as f64)
         };
-        let dims = ext.map(|e| {
+        let sub = ext.map(|e| if e > 0.0 { SUB } else { 1 });
+        let blocks = ext.map(|e| {
             if e > 0.0 {
                 ((e / side).round() as usize).clamp(1, 64)
             } else {
                 1
             }
         });
+        let dims = [0, 1, 2].map(|k| blocks[k] * sub[k]);
         let inv_cell = [0, 1, 2].map(|k| {
             if ext[k] > 0.0 {
                 dims[k] as f64 / ext[k]
@@ -97,6 +130,7 @@ impl HullGrid {
         let mut g = HullGrid {
             bb,
             dims,
+            stride: [1, dims[0], dims[0] * dims[1]],
             inv_cell,
             inside: vec![false; n],
             first: Vec::new(),
@@ -104,51 +138,84 @@ impl HullGrid {
             planes: Vec::new(),
         };
         let cell_w = [0, 1, 2].map(|k| ext[k] / dims[k] as f64);
-        // Entries per cell while building, then flattened in cell order.
+        // The widened box of the cells [a, b) along each axis, as centre and half extents.
+        let span = |a: [usize; 3], b: [usize; 3]| -> (V, V, V, V) {
+            let lo = [0, 1, 2].map(|k| bb.min[k] + a[k] as f64 * cell_w[k] - m);
+            let hi = [0, 1, 2].map(|k| bb.min[k] + b[k] as f64 * cell_w[k] + m);
+            let cen = [0, 1, 2].map(|k| 0.5 * (lo[k] + hi[k]));
+            let half = [0, 1, 2].map(|k| 0.5 * (hi[k] - lo[k]));
+            (lo, hi, cen, half)
+        };
+        // Entries per cell while building (hull, its box test needed, kept planes), then
+        // flattened in cell order.
         let mut per_cell: Vec<Vec<(u32, bool, Vec<(V, f64)>)>> = vec![Vec::new(); n];
+        let mut block_kept: Vec<(V, f64)> = Vec::new();
         let mut kept: Vec<(V, f64)> = Vec::new();
         for (hx, h) in hulls.iter().enumerate() {
-            if h.planes.is_empty() && h.verts.is_empty() {
-                continue;
-            }
             let lo_i = [0, 1, 2].map(|k| g.cell(k, h.bb.min[k]));
             let hi_i = [0, 1, 2].map(|k| g.cell(k, h.bb.max[k]));
-            for i2 in lo_i[2]..=hi_i[2] {
-                for i1 in lo_i[1]..=hi_i[1] {
-                    for i0 in lo_i[0]..=hi_i[0] {
-                        let c = (i2 * dims[1] + i1) * dims[0] + i0;
-                        if g.inside[c] {
-                            continue;
-                        }
-                        let idx = [i0, i1, i2];
-                        let lo = [0, 1, 2].map(|k| bb.min[k] + idx[k] as f64 * cell_w[k] - m);
-                        let hi = [0, 1, 2].map(|k| bb.min[k] + (idx[k] + 1) as f64 * cell_w[k] + m);
-                        let cen = [0, 1, 2].map(|k| 0.5 * (lo[k] + hi[k]));
-                        let half = [0, 1, 2].map(|k| 0.5 * (hi[k] - lo[k]));
-                        kept.clear();
+            let (lo_b, hi_b) = (
+                [0, 1, 2].map(|k| lo_i[k] / sub[k]),
+                [0, 1, 2].map(|k| hi_i[k] / sub[k]),
+            );
+            for b2 in lo_b[2]..=hi_b[2] {
+                for b1 in lo_b[1]..=hi_b[1] {
+                    for b0 in lo_b[0]..=hi_b[0] {
+                        let a = [b0 * sub[0], b1 * sub[1], b2 * sub[2]];
+                        let e = [0, 1, 2].map(|k| a[k] + sub[k]);
+                        let (_, _, cen, half) = span(a, e);
+                        block_kept.clear();
                         let mut out = false;
                         for &(nrm, d) in &h.planes {
-                            let mid = geom::dot(nrm, cen);
-                            let r = nrm[0].abs() * half[0]
-                                + nrm[1].abs() * half[1]
-                                + nrm[2].abs() * half[2];
-                            if mid - r > d + m {
-                                out = true;
-                                break;
-                            }
-                            if !(mid + r <= d - m) {
-                                kept.push((nrm, d));
+                            match box_vs_plane(cen, half, nrm, d, m) {
+                                Some(false) => {
+                                    out = true;
+                                    break;
+                                }
+                                Some(true) => {}
+                                None => block_kept.push((nrm, d)),
                             }
                         }
                         if out {
                             continue;
                         }
-                        let in_bb = (0..3).all(|k| h.bb.min[k] <= lo[k] && hi[k] <= h.bb.max[k]);
-                        if kept.is_empty() && in_bb {
-                            g.inside[c] = true;
-                            per_cell[c].clear();
-                        } else {
-                            per_cell[c].push((hx as u32, !in_bb, kept.clone()));
+                        // The block's cells that can hold a point of the hull's box.
+                        let c_lo = [0, 1, 2].map(|k| a[k].max(lo_i[k]));
+                        let c_hi = [0, 1, 2].map(|k| (e[k] - 1).min(hi_i[k]));
+                        for i2 in c_lo[2]..=c_hi[2] {
+                            for i1 in c_lo[1]..=c_hi[1] {
+                                for i0 in c_lo[0]..=c_hi[0] {
+                                    let c = i0 + i1 * g.stride[1] + i2 * g.stride[2];
+                                    if g.inside[c] {
+                                        continue;
+                                    }
+                                    let (lo, hi, cen, half) =
+                                        span([i0, i1, i2], [i0 + 1, i1 + 1, i2 + 1]);
+                                    kept.clear();
+                                    let mut out = false;
+                                    for &(nrm, d) in &block_kept {
+                                        match box_vs_plane(cen, half, nrm, d, m) {
+                                            Some(false) => {
+                                                out = true;
+                                                break;
+                                            }
+                                            Some(true) => {}
+                                            None => kept.push((nrm, d)),
+                                        }
+                                    }
+                                    if out {
+                                        continue;
+                                    }
+                                    let in_bb = (0..3)
+                                        .all(|k| h.bb.min[k] <= lo[k] && hi[k] <= h.bb.max[k]);
+                                    if kept.is_empty() && in_bb {
+                                        g.inside[c] = true;
+                                        per_cell[c].clear();
+                                    } else {
+                                        per_cell[c].push((hx as u32, !in_bb, kept.clone()));
+                                    }
+                                }
+                            }
                         }
                     }
                 }
@@ -162,7 +229,7 @@ impl HullGrid {
                     let start = g.planes.len() as u32;
                     g.planes.extend(ps);
                     g.entries.push(Entry {
-                        hull,
+                        bb: hulls[hull as usize].bb,
                         check_bb,
                         start,
                         end: g.planes.len() as u32,
@@ -175,36 +242,68 @@ impl HullGrid {
     }
 
     /// Index along axis k of the cell holding coordinate x (clamped to the grid): monotone
-    /// non-decreasing in x.
+    /// non-decreasing in x. `as` truncates: `floor` for the values >= 1 it sees, inlined.
     #[inline]
     fn cell(&self, k: usize, x: f64) -> usize {
-        let f = ((x - self.bb.min[k]) * self.inv_cell[k]).floor();
-        if f <= 0.0 {
+        let f = (x - self.bb.min[k]) * self.inv_cell[k];
+        if !(f >= 1.0) {
             0
         } else {
             (f as usize).min(self.dims[k] - 1)
         }
     }
 
-    /// Exactly `hulls.iter().any(|h| h.contains(p))` for the hulls the grid was built from.
+    /// The verdict of cell `c` on `p`, a point filed under it.
     #[inline]
-    pub fn contains(&self, hulls: &[Hull], p: V) -> bool {
-        if !self.bb.contains(p) {
-            return false;
-        }
-        let c = (self.cell(2, p[2]) * self.dims[1] + self.cell(1, p[1])) * self.dims[0]
-            + self.cell(0, p[0]);
+    fn resolve(&self, c: usize, p: V) -> bool {
         if self.inside[c] {
             return true;
         }
         self.entries[self.first[c] as usize..self.first[c + 1] as usize]
             .iter()
             .any(|e| {
-                (!e.check_bb || hulls[e.hull as usize].bb.contains(p))
+                (!e.check_bb || e.bb.contains(p))
                     && self.planes[e.start as usize..e.end as usize]
                         .iter()
                         .all(|(n, d)| geom::dot(*n, p) <= *d)
             })
+    }
+
+    /// Exactly `hulls.iter().any(|h| h.contains(p))` for the hulls the grid was built from.
+    #[inline]
+    pub fn contains(&self, p: V) -> bool {
+        if !self.bb.contains(p) {
+            return false;
+        }
+        let c = (0..3).map(|k| self.cell(k, p[k]) * self.stride[k]).sum();
+        self.resolve(c, p)
+    }
+
+    /// The column of points `base` with `base[axis]` replaced; `None` when it misses the grid
+    /// (no point of it is inside any hull).
+    #[inline]
+    pub fn column(&self, axis: usize, base: V) -> Option<Column> {
+        let mut offset = 0;
+        for k in [(axis + 1) % 3, (axis + 2) % 3] {
+            if !(self.bb.min[k] <= base[k] && base[k] <= self.bb.max[k]) {
+                return None;
+            }
+            offset += self.cell(k, base[k]) * self.stride[k];
+        }
+        Some(Column { axis, offset })
+    }
+
+    /// [`HullGrid::contains`] of `p`, a point of the column `col` (the same answer).
+    #[inline]
+    pub fn contains_in(&self, col: Column, p: V) -> bool {
+        let t = p[col.axis];
+        if !(self.bb.min[col.axis] <= t && t <= self.bb.max[col.axis]) {
+            return false;
+        }
+        self.resolve(
+            col.offset + self.cell(col.axis, t) * self.stride[col.axis],
+            p,
+        )
     }
 }
 
@@ -299,7 +398,11 @@ mod tests {
         let mut inside = 0;
         for p in &pts {
             let want = direct(*p);
-            assert_eq!(g.contains(&hulls, *p), want, "at {p:?}");
+            assert_eq!(g.contains(*p), want, "at {p:?}");
+            for axis in 0..3 {
+                let via_column = g.column(axis, *p).is_some_and(|c| g.contains_in(c, *p));
+                assert_eq!(via_column, want, "at {p:?} along {axis}");
+            }
             inside += want as usize;
         }
         // Both answers occur in quantity (the comparison is not vacuous).

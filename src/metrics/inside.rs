@@ -108,10 +108,13 @@ impl AxisGrid {
         g
     }
 
+    /// The cell index of coordinate x along kept axis k, clamped. `as` truncates, which is
+    /// `floor` for the values >= 1 it sees, and inlines where `floor` is a libm call (1.3 % of
+    /// validation's samples).
     #[inline]
     fn cell(&self, k: usize, x: f64) -> usize {
-        let f = ((x - self.min[k]) * self.inv_cell[k]).floor();
-        if f <= 0.0 {
+        let f = (x - self.min[k]) * self.inv_cell[k];
+        if !(f >= 1.0) {
             0
         } else {
             (f as usize).min(self.dims[k] - 1)

@@ -213,7 +213,7 @@ impl Prepared {
         }
         match &self.shape {
             Shape::Mesh(m) => m.contains(p),
-            Shape::Hulls(hs, Some(g)) => g.contains(hs, p),
+            Shape::Hulls(_, Some(g)) => g.contains(p),
             Shape::Hulls(hs, None) => hs.iter().any(|h| h.contains(p)),
         }
     }
@@ -477,13 +477,16 @@ fn classify_column(
                 *o = m.classify(p, axis, line, other);
             }
         }
-        Shape::Hulls(hs, Some(g)) => {
+        Shape::Hulls(_, Some(g)) => {
             // Each cell of the grid is resolved once (inside, outside, or the few plane tests
             // its points still need): the same answers as testing every hull, see `hullgrid`.
+            let Some(col) = g.column(axis, base) else {
+                return;
+            };
             for (o, &t) in out.iter_mut().zip(ts) {
                 let mut p = base;
                 p[axis] = t;
-                *o = g.contains(hs, p);
+                *o = g.contains_in(col, p);
             }
         }
         Shape::Hulls(hs, None) => {
