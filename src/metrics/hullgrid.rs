@@ -148,7 +148,8 @@ impl HullGrid {
         };
         // Entries per cell while building (hull, its box test needed, kept planes), then
         // flattened in cell order.
-        let mut per_cell: Vec<Vec<(u32, bool, Vec<(V, f64)>)>> = vec![Vec::new(); n];
+        type Pending = (u32, bool, Vec<(V, f64)>);
+        let mut per_cell: Vec<Vec<Pending>> = vec![Vec::new(); n];
         let mut block_kept: Vec<(V, f64)> = Vec::new();
         let mut kept: Vec<(V, f64)> = Vec::new();
         for (hx, h) in hulls.iter().enumerate() {
