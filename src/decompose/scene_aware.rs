@@ -108,6 +108,7 @@ mod object;
 mod parts;
 pub mod patches;
 mod polish;
+mod project;
 mod rebalance;
 mod refit;
 mod report;

@@ -207,7 +207,7 @@ impl Surface {
             }
             if !(m > 0.0 && self.within(p, m * (1.0 - WITHIN_MARGIN))) {
                 let q = to_dvec(p);
-                let proj = self.tri.project_point(&Pose::identity(), q, false);
+                let proj = self.project_until(q, stop.max(seam));
                 let d = (proj.point - q).length();
                 if !(self.sided && proj.is_inside && d <= seam) {
                     m = m.max(d);
@@ -966,7 +966,7 @@ pub fn radial_mesh(
 
 /// Relative margin by which [`Surface::within`] is asked for a tighter radius where an exact
 /// answer is needed: far above its rounding (1e-15), far below any distance that matters.
-const WITHIN_MARGIN: f64 = 1e-9;
+pub(super) const WITHIN_MARGIN: f64 = 1e-9;
 
 /// Squared distance from `p` to a BVH node's box (0 inside).
 fn aabb_dist2(node: &BvhNode, p: Vector) -> f64 {
