@@ -169,6 +169,8 @@ fn set(o: &mut SettleOptions, kv: &str) {
     match k {
         "dt" => o.dt = x,
         "solver_iterations" => o.solver_iterations = x as usize,
+        "pgs_iterations" => o.pgs_iterations = x as usize,
+        "stabilization_iterations" => o.stabilization_iterations = x as usize,
         "settle_max_time" => o.settle_max_time = x,
         "rest_time" => o.rest_time = x,
         "sleep_linear_threshold" => o.sleep_linear_threshold = x,

@@ -4,7 +4,7 @@
 //! and the full check (`physics::settle`: settle until asleep, then a 1 s awake rest phase with
 //! exact penetration queries every step).
 //!
-//! Run: `cargo run --release --example bench_settle`
+//! Run: `cargo run --release --example bench_settle [solver_iterations=N] [pgs_iterations=N]`
 
 use interact3d::mesh::{Mesh, P3, V3};
 use interact3d::physics::{settle, simulate, SettleOptions, SimBody};
@@ -89,14 +89,26 @@ fn best_of<T>(runs: usize, mut f: impl FnMut() -> T) -> (f64, T) {
 
 fn main() {
     let scene = [bowl(), block()];
-    let opts = SettleOptions::default();
+    // `solver_iterations=N` / `pgs_iterations=N`: measure another solver setting.
+    let mut opts = SettleOptions::default();
+    for a in std::env::args().skip(1) {
+        match a.split_once('=') {
+            Some(("solver_iterations", v)) => opts.solver_iterations = v.parse().expect("N"),
+            Some(("pgs_iterations", v)) => opts.pgs_iterations = v.parse().expect("N"),
+            _ => {
+                eprintln!("usage: bench_settle [solver_iterations=N] [pgs_iterations=N]");
+                std::process::exit(2)
+            }
+        }
+    }
     let hulls: usize = scene.iter().map(|b| b.hulls.len()).sum();
     println!(
-        "scene: bowl ({} hulls) + block ({} hulls), dt = 1/{:.0} s, {} solver iterations",
+        "scene: bowl ({} hulls) + block ({} hulls), dt = 1/{:.0} s, {} solver iterations, {} PGS sweeps each",
         scene[0].hulls.len(),
         scene[1].hulls.len(),
         1.0 / opts.dt,
-        opts.solver_iterations
+        opts.solver_iterations,
+        opts.pgs_iterations
     );
     println!(
         "{:<36} {:>7} {:>10} {:>12}",

@@ -70,8 +70,22 @@ pub struct SimBody {
 pub struct SettleOptions {
     /// Fixed time step (s).
     pub dt: f64,
-    /// Rapier solver iterations per step.
+    /// Rapier solver iterations per step (Rapier's default 4). In Rapier 0.36 each is a substep
+    /// (velocity solve, position integration, stabilization), so the soft contacts' substep `h`
+    /// is `dt / solver_iterations`. 8 substeps × 4 PGS sweeps ([`Self::pgs_iterations`]) hold
+    /// a light item loaded by a heavy one (a dice under a shoe) as MuJoCo and PhysX do, but
+    /// over 400 generated scenes they flipped as many other verdicts the other way (a lemon
+    /// rocking past the settle cap, drifts within 0.1 mm of the 10 % rule): not the default
+    /// (docs/agreement.md, "Fourth pass").
     pub solver_iterations: usize,
+    /// Projected Gauss-Seidel sweeps over the contacts within each substep (Rapier's
+    /// `num_internal_pgs_iterations`, default 1). More sweeps converge the impulses of coupled
+    /// contacts at the same positions without changing the substep, i.e. the contacts'
+    /// softness.
+    pub pgs_iterations: usize,
+    /// Unbiased (stabilization) sweeps after each substep's position update (Rapier's
+    /// `num_internal_stabilization_iterations`, default 1); friction acts here.
+    pub stabilization_iterations: usize,
     /// Gravitational acceleration along −z (m/s²).
     pub gravity: f64,
     /// Cap on the settle phase (s): it ends earlier when every dynamic body sleeps. 6 s: a
@@ -183,6 +197,8 @@ impl Default for SettleOptions {
         SettleOptions {
             dt: 1.0 / 240.0,
             solver_iterations: 4,
+            pgs_iterations: 1,
+            stabilization_iterations: 1,
             gravity: 9.81,
             settle_max_time: 6.0,
             rest_time: 1.0,

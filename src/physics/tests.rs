@@ -629,3 +629,23 @@ fn contact_rest_depth_scales_as_a_springs_and_damping_sets_the_push_out() {
     assert!(slow > 0.1e-3, "{slow}");
     assert!(slow > 5.0 * fast, "{slow} vs {fast}");
 }
+
+#[test]
+fn zero_pgs_sweeps_is_a_clear_options_error() {
+    // Rapier would run no velocity solve at all with 0 PGS sweeps (bodies fall through the
+    // floor); the options are refused up front, naming the field.
+    let b = [box_body(
+        "b",
+        V3::new(0.05, 0.05, 0.05),
+        0.1,
+        at(0.0, 0.0, 0.025),
+    )];
+    let opts = SettleOptions {
+        pgs_iterations: 0,
+        ..SettleOptions::default()
+    };
+    match settle(&b, &opts) {
+        Err(PhysicsError::InvalidOptions(m)) => assert!(m.contains("pgs_iterations"), "{m}"),
+        other => panic!("expected an options error, got {other:?}"),
+    }
+}

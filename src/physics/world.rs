@@ -120,6 +120,8 @@ impl<'a> Sim<'a> {
         let ip = &mut world.integration_parameters;
         ip.dt = opts.dt;
         ip.num_solver_iterations = opts.solver_iterations;
+        ip.num_internal_pgs_iterations = opts.pgs_iterations;
+        ip.num_internal_stabilization_iterations = opts.stabilization_iterations;
         ip.contact_recycling = opts.contact_recycling;
         ip.contact_clustering = opts.contact_clustering;
         ip.friction_in_bias_pass = opts.friction_in_bias_pass;
@@ -428,6 +430,9 @@ pub(super) fn validate_options(o: &SettleOptions) -> Result<(), PhysicsError> {
     }
     if o.solver_iterations == 0 {
         return bad("solver_iterations must be at least 1");
+    }
+    if o.pgs_iterations == 0 {
+        return bad("pgs_iterations must be at least 1");
     }
     let nonneg = [
         ("gravity", o.gravity),
