@@ -29,6 +29,7 @@ use std::path::Path;
 use std::time::Instant;
 
 mod guidance_stats;
+mod miss_probe;
 mod realistic_bench;
 
 struct Case {
