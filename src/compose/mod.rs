@@ -414,7 +414,6 @@ fn register(
         // scale. Judged by the guard with each pose's own offset taken out.
         if plane_icp::scale_offset_correlation(object) < OFFSET_CORRELATION_MAX {
             offset_stage(object, &matcher, &g_icp, &pl, &icp, &mut guard, &mut rms);
-            scale_sweep(object, &p, &matcher, &g_icp, &icp, &mut guard);
         }
     }
     let t = guard.pose();
@@ -465,39 +464,6 @@ fn offset_stage(
     guard.measure_offsets(OFFSET_MAX);
     if guard.offer("point_to_plane_offset", t) {
         *rms = r;
-    }
-}
-
-/// EXPERIMENT (issue #34, session 8): a wide scale sweep judged by the guard's offset-out fit.
-/// The scale search before it ranks ±6 % around the global stage's scale; a thin item whose
-/// global scale is 20 % off (the fork in a mug) stays there. Each scale of ±5, 10, 20 % (then
-/// ±2.5 % around the best) is refitted by a short fixed-scale point-to-plane ICP and offered.
-fn scale_sweep(
-    object: &Cloud,
-    p: &Problem,
-    matcher: &icp::Matcher,
-    g_icp: &Cloud,
-    icp: &IcpOptions,
-    guard: &mut guard::Guard,
-) {
-    let g = g_icp.subsample(700);
-    let c = p.object_obb.center;
-    let o = plane_icp::PlaneIcpOptions {
-        iterations: 15,
-        scale: false,
-        ..Default::default()
-    };
-    for steps in [
-        &[-0.2, -0.1, -0.05, 0.05, 0.1, 0.2][..],
-        &[-0.025, 0.025][..],
-    ] {
-        let base = guard.pose();
-        for f in steps {
-            let s = (base.scale * (1.0 + f)).clamp(icp.scale_lo, icp.scale_hi);
-            let (t, _) =
-                plane_icp::plane_icp(object, matcher, &g, scale::rescaled(&base, s, &c), &o);
-            guard.offer("scale_sweep", t);
-        }
     }
 }
 
