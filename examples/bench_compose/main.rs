@@ -13,7 +13,8 @@
 //! `--threads` cores, 1 by default).
 //! Beside each object: how far its guidance part is from the true surface (`guidance_stats`:
 //! outliers, uncovered surface, normal offset, extent ratio), which tells a registration miss from
-//! a part that does not show the object's size.
+//! a part that does not show the object's size. With `-v`, each miss's stage log and
+//! `miss_probe`: the fit at the truth against the estimate, and along a scale sweep.
 //!
 //! cargo run --release --example bench_compose [-- --seeds N] [--seed-offset N] [--threads N]
 //!     [--jobs N] [--only SUBSTRING,...] [-v]
@@ -29,6 +30,7 @@ use std::path::Path;
 use std::time::Instant;
 
 mod guidance_stats;
+mod miss_probe;
 mod realistic_bench;
 
 struct Case {

@@ -11,6 +11,7 @@ use std::path::Path;
 use std::time::Instant;
 
 use super::guidance_stats::{self, GuidanceStats};
+use super::miss_probe;
 
 /// (support or container, item, spread of the item's position over the support's half
 /// footprint). Every one of the 43 shared objects appears; flat supports: the plate, the
@@ -272,6 +273,7 @@ pub fn run(args: &[String]) {
                                 )
                             );
                             let truth_s = s.truth[n].scale;
+                            miss_probe::print(inp, &s.truth[n], &est, r.initial_scale);
                             for st in &r.stages {
                                 eprintln!(
                                     "      {:<20} fit {:.3e} scale {:+6.2} % {}",

@@ -1,0 +1,55 @@
+//! For a missed object (`-v`): is it a search failure or a guidance that does not show the
+//! object's size? Prints the OBB's initial scale, the guard's fit (mean truncated distance of
+//! guidance points to the posed surface, plain and with the pose's own normal offset taken out)
+//! at the true pose and at the estimate, and the offset-aware fit along a sweep of scales from
+//! the estimate (each scale refitted by a fixed-scale point-to-plane ICP): when the truth fits
+//! better than the estimate and the sweep reaches it, a wider scale search would fix the miss;
+//! when the estimate fits better, the guidance prefers the wrong size and no search on it can.
+
+use interact3d::compose::cloud::Cloud;
+use interact3d::compose::icp::Matcher;
+use interact3d::compose::kdtree::KdTree;
+use interact3d::compose::plane_icp::{offset_fit, plane_icp, surface_fit, PlaneIcpOptions};
+use interact3d::compose::scale::rescaled;
+use interact3d::compose::ObjectInput;
+use interact3d::pose::Similarity;
+
+pub fn print(inp: &ObjectInput, truth: &Similarity, est: &Similarity, initial_scale: f64) {
+    let oc = Cloud::sample(&inp.visual, 4000, 1);
+    let tree = KdTree::new(&oc.points);
+    let sp = interact3d::compose::guard::spacing(&inp.visual, 4000);
+    let gc = Cloud::sample(&inp.guidance, 1500, 2);
+    let probe = &gc.points[..gc.len().min(1000)];
+    let fit = |t: &Similarity| {
+        let cap = 0.03 * t.scale * oc.diagonal();
+        (
+            surface_fit(&oc, &tree, sp, probe, t, cap),
+            offset_fit(&oc, &tree, sp, probe, t, cap, cap).0,
+        )
+    };
+    let (ft, fto) = fit(truth);
+    let (fe, feo) = fit(est);
+    let rel = |s: f64| 100.0 * (s / truth.scale - 1.0);
+    eprintln!(
+        "      initial (OBB) scale {:+6.2} %; fit (plain / offset out): truth {ft:.3e} / {fto:.3e}, estimate {fe:.3e} / {feo:.3e}",
+        rel(initial_scale)
+    );
+    let m = Matcher::Geometry(&tree);
+    let c = interact3d::compose::obb::Obb::of_points(&oc.points).center;
+    let sweep: Vec<String> = [-0.2, -0.1, -0.05, 0.05, 0.1, 0.2]
+        .iter()
+        .map(|f| {
+            let s = est.scale * (1.0 + f);
+            let o = PlaneIcpOptions {
+                scale: false,
+                ..Default::default()
+            };
+            let (t, _) = plane_icp(&oc, &m, &gc, rescaled(est, s, &c), &o);
+            format!("{:+.0} %: {:.3e}", rel(s), fit(&t).1)
+        })
+        .collect();
+    eprintln!(
+        "      offset-out fit along a scale sweep from the estimate: {}",
+        sweep.join(", ")
+    );
+}
