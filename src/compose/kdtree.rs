@@ -331,7 +331,7 @@ mod exact_tests {
                 assert_eq!(t.nearest_from_n(q, i ^ 1), want);
             }
             if let Some((_, d)) = want {
-                ties += (pts.iter().filter(|p| d2(*p, q) == d).count() > 1) as usize;
+                ties += (pts.iter().filter(|p| d2(p, q) == d).count() > 1) as usize;
             }
             for &r2 in r2s {
                 assert_eq!(t.nearest_within_n(q, r2), brute(pts, q, r2), "{q:?} {r2}");
