@@ -211,10 +211,19 @@ pub fn fit(p: &Problem, t: &Similarity, probe_g: &[usize], probe_o: &[usize]) ->
     let tau = 0.02 * p.guidance_diagonal();
     let m = t.matrix();
     let inv = m.try_inverse().unwrap_or_else(nalgebra::Matrix4::identity);
+    // Only pairs within τ count, so the searches are bounded by τ (with a margin far above
+    // rounding; the test below still decides): the same answers as unbounded ones, found
+    // sooner on the many poses that are far off.
+    let slack = 1.0 + 1e-6;
+    let r2_object = if t.scale > 0.0 {
+        (tau / t.scale).powi(2) * slack
+    } else {
+        f64::INFINITY
+    };
     let (mut geo, mut col) = (0.0, 0.0);
     for &gi in probe_g {
         let q = inv.transform_point(&p.guidance.points[gi]);
-        if let Some((oi, d2)) = p.object_tree.nearest(&q) {
+        if let Some((oi, d2)) = p.object_tree.nearest_within(&q, r2_object) {
             if d2.sqrt() * t.scale < tau {
                 geo += 1.0;
                 let a = p.guidance.colours[gi];
@@ -229,7 +238,7 @@ pub fn fit(p: &Problem, t: &Similarity, probe_g: &[usize], probe_o: &[usize]) ->
         let q = m.transform_point(&p.object.points[oi]);
         let covered = p
             .guidance_tree
-            .nearest(&q)
+            .nearest_within(&q, tau * tau * slack)
             .is_some_and(|(_, d2)| d2.sqrt() < tau);
         if covered {
             back += 1.0;

@@ -85,16 +85,25 @@ impl<'a> Matcher<'a> {
 
     /// The object sample paired with `q` (object frame) of colour `colour`.
     pub fn nearest(&self, q: &P3, colour: &[f64; 3]) -> Option<(usize, f64)> {
+        self.nearest_from(q, colour, usize::MAX)
+    }
+
+    /// [`Self::nearest`] started from object sample `hint` (the same answer; see
+    /// [`KdTreeN::nearest_from_n`]).
+    pub fn nearest_from(&self, q: &P3, colour: &[f64; 3], hint: usize) -> Option<(usize, f64)> {
         match self {
-            Matcher::Geometry(t) => t.nearest(q),
-            Matcher::Colour { tree, weight } => tree.nearest_n(&[
-                q.x,
-                q.y,
-                q.z,
-                weight * colour[0],
-                weight * colour[1],
-                weight * colour[2],
-            ]),
+            Matcher::Geometry(t) => t.nearest_from(q, hint),
+            Matcher::Colour { tree, weight } => tree.nearest_from_n(
+                &[
+                    q.x,
+                    q.y,
+                    q.z,
+                    weight * colour[0],
+                    weight * colour[1],
+                    weight * colour[2],
+                ],
+                hint,
+            ),
         }
     }
 }
@@ -116,6 +125,8 @@ pub fn trimmed_icp(
     let mut pairs: Vec<(f64, usize, usize)> = Vec::with_capacity(n);
     let mut xs = Vec::with_capacity(n);
     let mut ys = Vec::with_capacity(n);
+    // Each guidance point's partner in the previous iteration: the next search starts there.
+    let mut prev = vec![usize::MAX; n];
     for _ in 0..o.iterations {
         let inv = t
             .matrix()
@@ -124,7 +135,8 @@ pub fn trimmed_icp(
         pairs.clear();
         for gi in 0..n {
             let q = inv.transform_point(&guidance.points[gi]);
-            if let Some((oi, _)) = matcher.nearest(&q, &guidance.colours[gi]) {
+            if let Some((oi, _)) = matcher.nearest_from(&q, &guidance.colours[gi], prev[gi]) {
+                prev[gi] = oi;
                 // Trim by the geometric distance only: with colour-aware matching the pairs
                 // whose colours disagree are the ones that turn a symmetric shape the right way;
                 // they are not outliers.

@@ -22,6 +22,8 @@ pub struct KdTreeN<const D: usize> {
     /// The points, in tree order after the build.
     pts: Vec<[f64; D]>,
     idx: Vec<u32>,
+    /// Tree position of each original index (the inverse of `idx`), for warm starts.
+    pos: Vec<u32>,
     nodes: Vec<Node<D>>,
 }
 
@@ -50,9 +52,20 @@ impl KdTree {
         KdTreeN::from_coords(points.iter().map(|p| [p.x, p.y, p.z]).collect())
     }
 
-    /// Index and squared distance of the nearest point (`None` for an empty tree).
+    /// Index and squared distance of the nearest point (`None` for an empty tree); ties go to
+    /// the lowest index.
     pub fn nearest(&self, p: &P3) -> Option<(usize, f64)> {
         self.nearest_n(&[p.x, p.y, p.z])
+    }
+
+    /// [`Self::nearest`] started from point `hint` (see [`KdTreeN::nearest_from_n`]).
+    pub fn nearest_from(&self, p: &P3, hint: usize) -> Option<(usize, f64)> {
+        self.nearest_from_n(&[p.x, p.y, p.z], hint)
+    }
+
+    /// [`Self::nearest`] when its squared distance is at most `r2`, else `None`.
+    pub fn nearest_within(&self, p: &P3, r2: f64) -> Option<(usize, f64)> {
+        self.nearest_within_n(&[p.x, p.y, p.z], r2)
     }
 
     /// Indices of all points within `r` of `p`, ascending.
@@ -65,6 +78,7 @@ impl<const D: usize> KdTreeN<D> {
     pub fn from_coords(pts: Vec<[f64; D]>) -> KdTreeN<D> {
         let mut t = KdTreeN {
             idx: (0..pts.len() as u32).collect(),
+            pos: Vec::new(),
             pts,
             nodes: Vec::new(),
         };
@@ -80,6 +94,10 @@ impl<const D: usize> KdTreeN<D> {
             // The points in tree order, so a leaf's points are contiguous in memory (`idx`
             // keeps their original indices).
             t.pts = t.idx.iter().map(|&i| t.pts[i as usize]).collect();
+            t.pos = vec![0; t.idx.len()];
+            for (k, &i) in t.idx.iter().enumerate() {
+                t.pos[i as usize] = k as u32;
+            }
         }
         t
     }
@@ -129,25 +147,50 @@ impl<const D: usize> KdTreeN<D> {
         self.build(left + 1, mid, end);
     }
 
-    /// Index and squared distance of the nearest point (`None` for an empty tree).
+    /// Index and squared distance of the nearest point (`None` for an empty tree). Of points
+    /// at the same distance, the lowest index: the answer of a brute-force scan.
     pub fn nearest_n(&self, q: &[f64; D]) -> Option<(usize, f64)> {
-        if self.pts.is_empty() {
+        self.search(q, f64::INFINITY, usize::MAX)
+    }
+
+    /// [`Self::nearest_n`] started from point `hint` (any index; out of range: no hint): the
+    /// same answer, found sooner when `hint` is near it, as the previous ICP iteration's
+    /// partner of the same guidance point is.
+    pub fn nearest_from_n(&self, q: &[f64; D], hint: usize) -> Option<(usize, f64)> {
+        self.search(q, f64::INFINITY, hint)
+    }
+
+    /// [`Self::nearest_n`] when its squared distance is at most `r2`, else `None`. A bounded
+    /// search prunes from the start: scoring a pose only asks whether a point is within τ.
+    pub fn nearest_within_n(&self, q: &[f64; D], r2: f64) -> Option<(usize, f64)> {
+        self.search(q, r2, usize::MAX)
+    }
+
+    /// The lexicographic minimum of (squared distance, index) over the points at squared
+    /// distance `<= r2`. Exact in floating point: a box's `box_d2` never exceeds the `d2` of a
+    /// point inside it (rounding is monotone), and a subtree is skipped only when its bound is
+    /// strictly above the best distance, so a tie at a lower index in another leaf is found.
+    /// A `hint` (an original index) seeds the best with its own (distance, index), a true
+    /// candidate, so the minimum is unchanged.
+    fn search(&self, q: &[f64; D], r2: f64, hint: usize) -> Option<(usize, f64)> {
+        if self.pts.is_empty() || box_d2(&self.nodes[0], q) > r2 {
             return None;
         }
         let q = *q;
-        let mut best = (usize::MAX, f64::INFINITY);
-        // A fixed stack instead of a heap allocation per query (this is the hottest loop of
-        // `compose`): a path holds at most one pending sibling per level, and median splits
-        // of 2^32 points are at most 32 levels deep.
-        let mut stack = [(0u32, 0.0f64); 66];
-        stack[0] = (0, box_d2(&self.nodes[0], &q));
-        let mut top = 1;
-        while top > 0 {
-            top -= 1;
-            let (n, bd) = stack[top];
-            if bd >= best.1 {
-                continue;
+        let mut best = (usize::MAX, r2);
+        if let Some(&k) = self.pos.get(hint) {
+            let d = d2(&self.pts[k as usize], &q);
+            if d <= r2 {
+                best = (hint, d);
             }
+        }
+        // A fixed stack instead of a heap allocation per query (this is the hottest loop of
+        // `compose`): one pending sibling per level at most, and median splits of 2^32 points
+        // are at most 32 levels deep. The nearer child is followed without a push.
+        let mut stack = [(0u32, 0.0f64); 66];
+        let mut top = 0;
+        let mut n = 0u32;
+        loop {
             let node = &self.nodes[n as usize];
             if node.left == 0 {
                 let (a, b) = (node.start as usize, node.end as usize);
@@ -157,22 +200,37 @@ impl<const D: usize> KdTreeN<D> {
                         best = (i as usize, d);
                     }
                 }
-                continue;
-            }
-            let l = node.left;
-            let dl = box_d2(&self.nodes[l as usize], &q);
-            let dr = box_d2(&self.nodes[l as usize + 1], &q);
-            // Push the farther first so the nearer is visited first.
-            if dl <= dr {
-                stack[top] = (l + 1, dr);
-                stack[top + 1] = (l, dl);
             } else {
-                stack[top] = (l, dl);
-                stack[top + 1] = (l + 1, dr);
+                let l = node.left;
+                let dl = box_d2(&self.nodes[l as usize], &q);
+                let dr = box_d2(&self.nodes[l as usize + 1], &q);
+                let (near, dn, far, df) = if dl <= dr {
+                    (l, dl, l + 1, dr)
+                } else {
+                    (l + 1, dr, l, dl)
+                };
+                if df <= best.1 {
+                    stack[top] = (far, df);
+                    top += 1;
+                }
+                if dn <= best.1 {
+                    n = near;
+                    continue;
+                }
             }
-            top += 2;
+            // The next pending subtree that may still hold a point at or below the best.
+            loop {
+                if top == 0 {
+                    return (best.0 != usize::MAX).then_some(best);
+                }
+                top -= 1;
+                let (m, bd) = stack[top];
+                if bd <= best.1 {
+                    n = m;
+                    break;
+                }
+            }
         }
-        Some(best)
     }
 
     /// Indices of all points within `r` of `q`, ascending.
@@ -237,5 +295,142 @@ mod tests {
                 .collect();
             assert_eq!(out, bf);
         }
+    }
+}
+
+#[cfg(test)]
+mod exact_tests {
+    //! The tree against a brute-force scan, ties included: the lowest index of the points at
+    //! the minimum squared distance (computed by the same `d2`), on random and degenerate sets.
+    use super::*;
+    use crate::rng::Rng;
+
+    fn brute<const D: usize>(pts: &[[f64; D]], q: &[f64; D], r2: f64) -> Option<(usize, f64)> {
+        let mut best: Option<(usize, f64)> = None;
+        for (i, p) in pts.iter().enumerate() {
+            let d = d2(p, q);
+            if d <= r2 && best.is_none_or(|b| d < b.1) {
+                best = Some((i, d));
+            }
+        }
+        best
+    }
+
+    fn check<const D: usize>(pts: &[[f64; D]], queries: &[[f64; D]], r2s: &[f64]) -> usize {
+        let t = KdTreeN::from_coords(pts.to_vec());
+        let mut ties = 0;
+        for q in queries {
+            let want = brute(pts, q, f64::INFINITY);
+            assert_eq!(t.nearest_n(q), want, "query {q:?}");
+            // Warm starts from any point (near, far, the answer itself, out of range).
+            for hint in [0, pts.len() / 2, pts.len().saturating_sub(1), usize::MAX] {
+                assert_eq!(t.nearest_from_n(q, hint), want, "{q:?} from {hint}");
+            }
+            if let Some((i, _)) = want {
+                assert_eq!(t.nearest_from_n(q, i), want);
+                assert_eq!(t.nearest_from_n(q, i ^ 1), want);
+            }
+            if let Some((_, d)) = want {
+                ties += (pts.iter().filter(|p| d2(p, q) == d).count() > 1) as usize;
+            }
+            for &r2 in r2s {
+                assert_eq!(t.nearest_within_n(q, r2), brute(pts, q, r2), "{q:?} {r2}");
+            }
+        }
+        ties
+    }
+
+    fn queries(rng: &mut Rng, pts: &[[f64; 3]], n: usize) -> Vec<[f64; 3]> {
+        // The points themselves (exact hits, duplicates' ties), points on a grid of half steps
+        // (equidistant from grid neighbours), and random points around the set.
+        let mut q: Vec<[f64; 3]> = pts.iter().step_by(7).copied().collect();
+        for _ in 0..n {
+            q.push([
+                (rng.range(-0.5, 4.5) * 2.0).round() / 2.0,
+                (rng.range(-0.5, 4.5) * 2.0).round() / 2.0,
+                (rng.range(-0.5, 4.5) * 2.0).round() / 2.0,
+            ]);
+            q.push([
+                rng.range(-1.0, 5.0),
+                rng.range(-1.0, 5.0),
+                rng.range(-1.0, 5.0),
+            ]);
+        }
+        q
+    }
+
+    #[test]
+    fn nearest_is_the_brute_force_answer_with_ties() {
+        let mut rng = Rng::new(11);
+        let r2s = [0.0, 0.25, 0.5, 1.0, 2.0];
+        // Random.
+        let random: Vec<[f64; 3]> = (0..3000)
+            .map(|_| {
+                [
+                    rng.range(0.0, 4.0),
+                    rng.range(0.0, 4.0),
+                    rng.range(0.0, 4.0),
+                ]
+            })
+            .collect();
+        let q = queries(&mut rng, &random, 300);
+        check(&random, &q, &r2s);
+        // An integer grid (5^3): many equidistant neighbours, splits through equal coordinates.
+        let grid: Vec<[f64; 3]> = (0..125)
+            .map(|i| [(i % 5) as f64, ((i / 5) % 5) as f64, (i / 25) as f64])
+            .collect();
+        let q = queries(&mut rng, &grid, 300);
+        let grid_ties = check(&grid, &q, &r2s);
+        // Every point four times (duplicates spread over leaves by the median splits), in a
+        // shuffled order so the lowest index is not always the first copy.
+        let mut dup: Vec<[f64; 3]> = (0..4).flat_map(|_| grid.iter().copied()).collect();
+        for i in (1..dup.len()).rev() {
+            dup.swap(i, (rng.next_f64() * (i + 1) as f64) as usize % (i + 1));
+        }
+        let q = queries(&mut rng, &dup, 300);
+        let dup_ties = check(&dup, &q, &r2s);
+        // A single point repeated: every query is a 40-way tie.
+        let same = vec![[1.0, 2.0, 3.0]; 40];
+        let q = queries(&mut rng, &same, 50);
+        assert_eq!(check(&same, &q, &r2s), q.len());
+        // Coplanar (z = 2): an integer grid, and random points beside it.
+        let plane: Vec<[f64; 3]> = (0..900)
+            .map(|i| {
+                if i % 2 == 0 {
+                    [((i / 2) % 15) as f64, ((i / 2) / 15) as f64, 2.0]
+                } else {
+                    [rng.range(15.0, 19.0), rng.range(0.0, 4.0), 2.0]
+                }
+            })
+            .collect();
+        let q = queries(&mut rng, &plane, 300);
+        let plane_ties = check(&plane, &q, &r2s);
+        // The sets above do exercise ties.
+        eprintln!("ties: grid {grid_ties}, duplicates {dup_ties}, plane {plane_ties}");
+        assert!(grid_ties > 100 && dup_ties > 300 && plane_ties > 50);
+        // Collinear points, six coordinates (the colour tree's shape) with duplicates.
+        let line: Vec<[f64; 6]> = (0..600)
+            .map(|i| {
+                let x = (i % 200) as f64 * 0.5;
+                [x, 0.0, 0.0, 0.1, 0.1, 0.1]
+            })
+            .collect();
+        let q: Vec<[f64; 6]> = (0..400)
+            .map(|i| {
+                let x = (i as f64 * 0.25).round() / 2.0 + if i % 3 == 0 { 0.25 } else { 0.0 };
+                [x, rng.range(-1.0, 1.0), 0.0, 0.1, 0.1, rng.range(0.0, 0.2)]
+            })
+            .collect();
+        assert!(check(&line, &q, &r2s) > 300);
+    }
+
+    #[test]
+    fn empty_tree_and_bound_below_the_root_box() {
+        let t = KdTreeN::<3>::from_coords(Vec::new());
+        assert_eq!(t.nearest_n(&[0.0; 3]), None);
+        let t = KdTreeN::from_coords(vec![[1.0, 0.0, 0.0], [3.0, 0.0, 0.0]]);
+        assert_eq!(t.nearest_within_n(&[-1.0, 0.0, 0.0], 3.99), None);
+        assert_eq!(t.nearest_within_n(&[-1.0, 0.0, 0.0], 4.0), Some((0, 4.0)));
+        assert_eq!(t.nearest_n(&[2.0, 0.0, 0.0]), Some((0, 1.0)));
     }
 }

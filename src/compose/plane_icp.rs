@@ -104,6 +104,8 @@ pub fn plane_icp_offset(
     let n = guidance.len();
     // (point distance², plane residual, guidance index, object index)
     let mut pairs: Vec<(f64, usize, usize)> = Vec::with_capacity(n);
+    // Each guidance point's partner in the previous iteration: the next search starts there.
+    let mut prev = vec![usize::MAX; n];
     for _ in 0..o.iterations {
         let Some(inv) = t.matrix().try_inverse() else {
             break;
@@ -112,7 +114,8 @@ pub fn plane_icp_offset(
         pairs.clear();
         for gi in 0..n {
             let q = inv.transform_point(&guidance.points[gi]);
-            if let Some((oi, _)) = matcher.nearest(&q, &guidance.colours[gi]) {
+            if let Some((oi, _)) = matcher.nearest_from(&q, &guidance.colours[gi], prev[gi]) {
+                prev[gi] = oi;
                 let p = m.transform_point(&object.points[oi]);
                 pairs.push(((p - guidance.points[gi]).norm_squared(), gi, oi));
             }
