@@ -120,7 +120,8 @@ impl Build<'_> {
 
     /// The node of cells [a, b) (b exclusive), whose parent left `stack[from..]` undecided:
     /// dropped when outside some plane, marked inside when inside every plane and the hull's
-    /// box, a record when it is one cell, and otherwise split in two along its longest side.
+    /// box, a record when it is one cell, and otherwise split at the middle of every side longer
+    /// than one cell.
     /// A child's widened box lies in its parent's, so a parent's verdict on a plane holds for
     /// its children.
     fn node(&mut self, a: [usize; 3], b: [usize; 3], from: usize) {
@@ -158,13 +159,24 @@ impl Build<'_> {
                 self.recs.push((c as u32, Entry { bbx, start, end }));
             }
         } else {
-            let k = (0..3).max_by_key(|&k| (b[k] - a[k], 3 - k)).unwrap_or(0);
-            let mid = a[k] + (b[k] - a[k]) / 2;
-            let (mut b1, mut a2) = (b, a);
-            b1[k] = mid;
-            a2[k] = mid;
-            self.node(a, b1, to);
-            self.node(a2, b, to);
+            // Split every side of two cells or more at its middle (up to eight children).
+            let mid = [0, 1, 2].map(|k| a[k] + (b[k] - a[k]) / 2);
+            let halves = [0, 1, 2].map(|k| {
+                if b[k] - a[k] >= 2 {
+                    [(a[k], mid[k]), (mid[k], b[k])]
+                } else {
+                    [(a[k], b[k]), (b[k], b[k])]
+                }
+            });
+            for &(a2, b2) in &halves[2] {
+                for &(a1, b1) in &halves[1] {
+                    for &(a0, b0) in &halves[0] {
+                        if a0 < b0 && a1 < b1 && a2 < b2 {
+                            self.node([a0, a1, a2], [b0, b1, b2], to);
+                        }
+                    }
+                }
+            }
         }
         self.stack.truncate(to);
     }
