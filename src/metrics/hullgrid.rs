@@ -23,29 +23,33 @@
 //! planes in any order. A grid whose box is not finite is not built (the caller tests every
 //! hull).
 //!
-//! Cells are resolved in blocks of 2×2×2: a block's verdict on a plane holds for its cells
-//! (their widened boxes lie in the block's), so a cell only looks at the planes that cross its
-//! block, and cells of a block outside a hull are not looked at.
+//! Each hull's cells are resolved by bisection from its box's cells: a node's verdict on a
+//! plane holds for its children (their widened boxes lie in the node's), so a node only looks
+//! at the planes that cross its parent, and nodes outside a hull or inside it are not split.
+//! The entries are gathered as flat records and put in cell order by counting.
 
 use super::bvh::Bb;
 use super::geom::{self, V};
 use super::inside::Hull;
 
-/// Blocks of the grid, about; shaped like the box. Resolving a block costs one pass over the
-/// planes of each hull whose box it meets, so this bounds the preparation.
+/// Blocks of the grid, about; shaped like the box (the grid has `SUB` cells a block along each
+/// axis with an extent). The resolution the queries see; unchanged by the bisection build.
 const TARGET_BLOCKS: f64 = 8192.0;
 /// Cells per block along each axis with an extent.
 const SUB: usize = 2;
 
-/// What the points of one cell still need: the hull's box test (unless the cell is inside
-/// that box) and the planes `planes[start..end]` (copies, contiguous per cell).
-#[derive(Clone, Debug)]
+/// What the points of one cell still need from one hull: its box test (`bbx`, an index into
+/// [`HullGrid::boxes`], or [`NO_BOX`] when the cell lies inside that box) and the planes
+/// `planes[start..end]` (copies, contiguous per entry).
+#[derive(Clone, Copy, Debug)]
 struct Entry {
-    bb: Bb,
-    check_bb: bool,
+    bbx: u32,
     start: u32,
     end: u32,
 }
+
+/// [`Entry::bbx`] of an entry whose cell lies inside its hull's box.
+const NO_BOX: u32 = u32::MAX;
 
 #[derive(Clone, Debug)]
 pub struct HullGrid {
@@ -60,6 +64,8 @@ pub struct HullGrid {
     first: Vec<u32>,
     entries: Vec<Entry>,
     planes: Vec<(V, f64)>,
+    /// The hulls' bounding boxes, by hull index.
+    boxes: Vec<Bb>,
 }
 
 /// The cells of one column: the index of its first cell and the axis it runs along.
@@ -84,9 +90,106 @@ fn box_vs_plane(cen: V, half: V, n: V, d: f64, m: f64) -> Option<bool> {
     }
 }
 
+/// The build's state for one hull's bisection: the grid's geometry, where records go, and a
+/// stack of the planes each open node still has undecided.
+struct Build<'a> {
+    bb: Bb,
+    cell_w: [f64; 3],
+    stride: [usize; 3],
+    m: f64,
+    hull: &'a Hull,
+    hx: u32,
+    inside: &'a mut Vec<bool>,
+    /// (cell, entry) in the order found; planes of the entries in `planes`.
+    recs: &'a mut Vec<(u32, Entry)>,
+    planes: &'a mut Vec<(V, f64)>,
+    /// Undecided planes of the nodes on the current path, each node's after its parent's.
+    stack: Vec<(V, f64)>,
+}
+
+impl Build<'_> {
+    /// The widened box of the cells [a, b) along each axis, as low and high corners, centre
+    /// and half extents.
+    fn span(&self, a: [usize; 3], b: [usize; 3]) -> (V, V, V, V) {
+        let lo = [0, 1, 2].map(|k| self.bb.min[k] + a[k] as f64 * self.cell_w[k] - self.m);
+        let hi = [0, 1, 2].map(|k| self.bb.min[k] + b[k] as f64 * self.cell_w[k] + self.m);
+        let cen = [0, 1, 2].map(|k| 0.5 * (lo[k] + hi[k]));
+        let half = [0, 1, 2].map(|k| 0.5 * (hi[k] - lo[k]));
+        (lo, hi, cen, half)
+    }
+
+    /// The node of cells [a, b) (b exclusive), whose parent left `stack[from..]` undecided:
+    /// dropped when outside some plane, marked inside when inside every plane and the hull's
+    /// box, a record when it is one cell, and otherwise split at the middle of every side longer
+    /// than one cell.
+    /// A child's widened box lies in its parent's, so a parent's verdict on a plane holds for
+    /// its children.
+    fn node(&mut self, a: [usize; 3], b: [usize; 3], from: usize) {
+        let (lo, hi, cen, half) = self.span(a, b);
+        let to = self.stack.len();
+        for i in from..to {
+            let (nrm, d) = self.stack[i];
+            match box_vs_plane(cen, half, nrm, d, self.m) {
+                Some(false) => {
+                    self.stack.truncate(to);
+                    return;
+                }
+                Some(true) => {}
+                None => self.stack.push((nrm, d)),
+            }
+        }
+        let bb = &self.hull.bb;
+        let in_bb = (0..3).all(|k| bb.min[k] <= lo[k] && hi[k] <= bb.max[k]);
+        let one = (0..3).all(|k| b[k] == a[k] + 1);
+        if self.stack.len() == to && in_bb {
+            for i2 in a[2]..b[2] {
+                for i1 in a[1]..b[1] {
+                    for i0 in a[0]..b[0] {
+                        self.inside[i0 + i1 * self.stride[1] + i2 * self.stride[2]] = true;
+                    }
+                }
+            }
+        } else if one {
+            let c = a[0] + a[1] * self.stride[1] + a[2] * self.stride[2];
+            if !self.inside[c] {
+                let start = self.planes.len() as u32;
+                self.planes.extend_from_slice(&self.stack[to..]);
+                let bbx = if in_bb { NO_BOX } else { self.hx };
+                let end = self.planes.len() as u32;
+                self.recs.push((c as u32, Entry { bbx, start, end }));
+            }
+        } else {
+            // Split every side of two cells or more at its middle (up to eight children).
+            let mid = [0, 1, 2].map(|k| a[k] + (b[k] - a[k]) / 2);
+            let halves = [0, 1, 2].map(|k| {
+                if b[k] - a[k] >= 2 {
+                    [(a[k], mid[k]), (mid[k], b[k])]
+                } else {
+                    [(a[k], b[k]), (b[k], b[k])]
+                }
+            });
+            for &(a2, b2) in &halves[2] {
+                for &(a1, b1) in &halves[1] {
+                    for &(a0, b0) in &halves[0] {
+                        if a0 < b0 && a1 < b1 && a2 < b2 {
+                            self.node([a0, a1, a2], [b0, b1, b2], to);
+                        }
+                    }
+                }
+            }
+        }
+        self.stack.truncate(to);
+    }
+}
+
 impl HullGrid {
     /// The grid over the union of the hulls' boxes; `None` when that box is empty or not
     /// finite.
+    ///
+    /// Each hull is bisected from the cells of its box down to single cells, only where its
+    /// boundary crosses: a node outside a face plane is dropped, a node inside the hull marks
+    /// its cells inside, and a node's children only test the planes it left undecided. The
+    /// cells' entries are found as flat records, then put in cell order (no vector per cell).
     pub fn new(hulls: &[Hull]) -> Option<HullGrid> {
         let mut bb = Bb::EMPTY;
         for h in hulls {
@@ -136,109 +239,61 @@ impl HullGrid {
             first: Vec::new(),
             entries: Vec::new(),
             planes: Vec::new(),
+            boxes: hulls.iter().map(|h| h.bb).collect(),
         };
         let cell_w = [0, 1, 2].map(|k| ext[k] / dims[k] as f64);
-        // The widened box of the cells [a, b) along each axis, as centre and half extents.
-        let span = |a: [usize; 3], b: [usize; 3]| -> (V, V, V, V) {
-            let lo = [0, 1, 2].map(|k| bb.min[k] + a[k] as f64 * cell_w[k] - m);
-            let hi = [0, 1, 2].map(|k| bb.min[k] + b[k] as f64 * cell_w[k] + m);
-            let cen = [0, 1, 2].map(|k| 0.5 * (lo[k] + hi[k]));
-            let half = [0, 1, 2].map(|k| 0.5 * (hi[k] - lo[k]));
-            (lo, hi, cen, half)
-        };
-        // Entries per cell while building (hull, its box test needed, kept planes), then
-        // flattened in cell order.
-        type Pending = (u32, bool, Vec<(V, f64)>);
-        let mut per_cell: Vec<Vec<Pending>> = vec![Vec::new(); n];
-        let mut block_kept: Vec<(V, f64)> = Vec::new();
-        let mut kept: Vec<(V, f64)> = Vec::new();
+        let mut recs: Vec<(u32, Entry)> = Vec::new();
+        let mut planes: Vec<(V, f64)> = Vec::new();
+        let mut stack: Vec<(V, f64)> = Vec::new();
         for (hx, h) in hulls.iter().enumerate() {
+            // The cells that can hold a point of the hull's box.
             let lo_i = [0, 1, 2].map(|k| g.cell(k, h.bb.min[k]));
-            let hi_i = [0, 1, 2].map(|k| g.cell(k, h.bb.max[k]));
-            let (lo_b, hi_b) = (
-                [0, 1, 2].map(|k| lo_i[k] / sub[k]),
-                [0, 1, 2].map(|k| hi_i[k] / sub[k]),
-            );
-            for b2 in lo_b[2]..=hi_b[2] {
-                for b1 in lo_b[1]..=hi_b[1] {
-                    for b0 in lo_b[0]..=hi_b[0] {
-                        let a = [b0 * sub[0], b1 * sub[1], b2 * sub[2]];
-                        let e = [0, 1, 2].map(|k| a[k] + sub[k]);
-                        let (_, _, cen, half) = span(a, e);
-                        block_kept.clear();
-                        let mut out = false;
-                        for &(nrm, d) in &h.planes {
-                            match box_vs_plane(cen, half, nrm, d, m) {
-                                Some(false) => {
-                                    out = true;
-                                    break;
-                                }
-                                Some(true) => {}
-                                None => block_kept.push((nrm, d)),
-                            }
-                        }
-                        if out {
-                            continue;
-                        }
-                        // The block's cells that can hold a point of the hull's box.
-                        let c_lo = [0, 1, 2].map(|k| a[k].max(lo_i[k]));
-                        let c_hi = [0, 1, 2].map(|k| (e[k] - 1).min(hi_i[k]));
-                        for i2 in c_lo[2]..=c_hi[2] {
-                            for i1 in c_lo[1]..=c_hi[1] {
-                                for i0 in c_lo[0]..=c_hi[0] {
-                                    let c = i0 + i1 * g.stride[1] + i2 * g.stride[2];
-                                    if g.inside[c] {
-                                        continue;
-                                    }
-                                    let (lo, hi, cen, half) =
-                                        span([i0, i1, i2], [i0 + 1, i1 + 1, i2 + 1]);
-                                    kept.clear();
-                                    let mut out = false;
-                                    for &(nrm, d) in &block_kept {
-                                        match box_vs_plane(cen, half, nrm, d, m) {
-                                            Some(false) => {
-                                                out = true;
-                                                break;
-                                            }
-                                            Some(true) => {}
-                                            None => kept.push((nrm, d)),
-                                        }
-                                    }
-                                    if out {
-                                        continue;
-                                    }
-                                    let in_bb = (0..3)
-                                        .all(|k| h.bb.min[k] <= lo[k] && hi[k] <= h.bb.max[k]);
-                                    if kept.is_empty() && in_bb {
-                                        g.inside[c] = true;
-                                        per_cell[c].clear();
-                                    } else {
-                                        per_cell[c].push((hx as u32, !in_bb, kept.clone()));
-                                    }
-                                }
-                            }
-                        }
-                    }
-                }
+            let hi_i = [0, 1, 2].map(|k| g.cell(k, h.bb.max[k]) + 1);
+            stack.clear();
+            stack.extend_from_slice(&h.planes);
+            let mut b = Build {
+                bb,
+                cell_w,
+                stride: g.stride,
+                m,
+                hull: h,
+                hx: hx as u32,
+                inside: &mut g.inside,
+                recs: &mut recs,
+                planes: &mut planes,
+                stack: std::mem::take(&mut stack),
+            };
+            b.node(lo_i, hi_i, 0);
+            stack = b.stack;
+        }
+        // Records of cells found inside a later hull are dropped; the rest are put in cell
+        // order by counting (stable: a cell's entries keep the hulls' order).
+        let mut first = vec![0u32; n + 1];
+        for &(c, _) in &recs {
+            if !g.inside[c as usize] {
+                first[c as usize + 1] += 1;
             }
         }
-        g.first.reserve(n + 1);
-        g.first.push(0);
-        for (c, list) in per_cell.into_iter().enumerate() {
-            if !g.inside[c] {
-                for (hull, check_bb, ps) in list {
-                    let start = g.planes.len() as u32;
-                    g.planes.extend(ps);
-                    g.entries.push(Entry {
-                        bb: hulls[hull as usize].bb,
-                        check_bb,
-                        start,
-                        end: g.planes.len() as u32,
-                    });
-                }
-            }
-            g.first.push(g.entries.len() as u32);
+        for c in 0..n {
+            first[c + 1] += first[c];
         }
+        let mut next = first.clone();
+        let none = Entry {
+            bbx: NO_BOX,
+            start: 0,
+            end: 0,
+        };
+        let mut entries = vec![none; first[n] as usize];
+        for (c, e) in recs {
+            if !g.inside[c as usize] {
+                let slot = &mut next[c as usize];
+                entries[*slot as usize] = e;
+                *slot += 1;
+            }
+        }
+        g.first = first;
+        g.entries = entries;
+        g.planes = planes;
         Some(g)
     }
 
@@ -263,7 +318,7 @@ impl HullGrid {
         self.entries[self.first[c] as usize..self.first[c + 1] as usize]
             .iter()
             .any(|e| {
-                (!e.check_bb || e.bb.contains(p))
+                (e.bbx == NO_BOX || self.boxes[e.bbx as usize].contains(p))
                     && self.planes[e.start as usize..e.end as usize]
                         .iter()
                         .all(|(n, d)| geom::dot(*n, p) <= *d)

@@ -250,6 +250,12 @@ impl RayMesh {
         let mut line = Vec::new();
         let mut votes = 0;
         for axis in 0..3 {
+            // After two lines (four half-lines), 0 or 4 votes decide: the third line's two
+            // votes leave the total below 3 or above 3 (never the 3:3 tie), so its crossings
+            // cannot change the verdict and are not computed.
+            if axis == 2 && (votes == 0 || votes == 4) {
+                break;
+            }
             self.crossings(axis, p, &mut line);
             let below = line.partition_point(|&t| t < p[axis]);
             votes += below % 2 + (line.len() - below) % 2;

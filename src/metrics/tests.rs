@@ -473,3 +473,60 @@ fn deterministic_across_runs_and_thread_counts() {
         assert!(j.get(k).is_some(), "{k} missing in {j}");
     }
 }
+
+/// `RayMesh::contains` stops after two lines when they give 0 or 4 of the six votes. Against
+/// the full vote (all three lines, ties to the winding number) on an open sphere, where the
+/// lines disagree near the opening (turned to face +x, so the first line goes through it):
+/// every answer the same, and both the early stop and the full vote occur in quantity.
+#[test]
+fn contains_stopping_after_two_lines_answers_as_the_full_vote() {
+    let (r, stacks, slices) = (0.05, 32, 64);
+    let s = uv_sphere(r, stacks, slices);
+    let cap = slices + 3 * 2 * slices;
+    // A quarter turn about y: (x, y, z) -> (z, y, -x), the opening from -z to +x.
+    let turn = Matrix4::new(
+        0.0, 0.0, 1.0, 0.0, 0.0, 1.0, 0.0, 0.0, -1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0,
+    );
+    let open = Mesh::new(
+        s.vertices.clone(),
+        s.triangles[..s.triangles.len() - cap].to_vec(),
+    )
+    .transformed(&turn);
+    let po = prep(&open);
+    let Shape::Mesh(rm) = &po.shape else {
+        unreachable!()
+    };
+    let mut line = Vec::new();
+    let full = |p: V, line: &mut Vec<f64>| -> (bool, usize) {
+        let mut votes = Vec::new();
+        for axis in 0..3 {
+            rm.crossings(axis, p, line);
+            let below = line.partition_point(|&t| t < p[axis]);
+            votes.push(below % 2 + (line.len() - below) % 2);
+        }
+        let total: usize = votes.iter().sum();
+        let inside = match total {
+            v if v > 3 => true,
+            v if v < 3 => false,
+            _ => rm.winding_number(p).abs() > 0.5,
+        };
+        (inside, votes[0] + votes[1])
+    };
+    let mut rng = Rng(11);
+    let (mut early, mut late, mut inside) = (0, 0, 0);
+    for _ in 0..20_000 {
+        let p = [0.0, 1.0, 2.0].map(|_| (rng.next_f64() * 2.0 - 1.0) * 1.05 * r);
+        let (want, two) = full(p, &mut line);
+        assert_eq!(rm.contains(p), want, "at {p:?}");
+        if geom::norm2(p) <= r * r {
+            if two == 0 || two == 4 {
+                early += 1;
+            } else {
+                late += 1;
+            }
+        }
+        inside += usize::from(want);
+    }
+    assert!(early > 1000 && late > 100, "{early} {late}");
+    assert!(inside > 2000 && inside < 18_000, "{inside}");
+}
