@@ -167,7 +167,8 @@ pub(super) fn decompose_object(
     report.top_down = p.strategy == Strategy::Planes;
     // Concavities the chosen patches fill, opened with the budget they have (`unfill.rs`).
     if effort.polish > 0 && parts.len() >= budget {
-        report.unfilled = unfill::unfill(s, &feat, &p, opts, &mut parts, UNFILL_ROUNDS, near);
+        let h2m = dist.map_or(f64::INFINITY, |d| d.0);
+        report.unfilled = unfill::unfill(s, &feat, &p, opts, &mut parts, UNFILL_ROUNDS, near, h2m);
         if report.unfilled > 0 {
             dist = distance_stats(s, &hulls_of(&parts));
         }

@@ -12,7 +12,10 @@
 //! more than the two did. The move is kept only when the object's two-sided estimate (the
 //! larger of the hull → mesh 95th percentile and the mesh → hulls one by face planes) drops
 //! by [`MIN_GAIN`] of the diagonal, and the surface outside every hull does not grow at the
-//! 99th percentile. Hull count, pins and lifts are kept as in the rebalancing.
+//! 99th percentile. Hull count, pins and lifts are kept as in the rebalancing. Objects whose
+//! mesh → hulls side does not already exceed the hull → mesh one are skipped, and a move's
+//! hull → mesh percentile is measured only when its mesh → hulls side and outside depth pass
+//! (the CPU limit of #35: at most 5 % more than without the pass).
 
 use super::geom::Surface;
 use super::metrics;
@@ -44,16 +47,16 @@ fn fill(h: &Hull, pts: &[P3], deep: f64) -> f64 {
         .sum()
 }
 
-/// (two-sided estimate, outside p99), fractions of the diagonal.
-fn estimate(s: &Surface, parts: &[Part], pts: &[P3]) -> (f64, f64) {
-    let hulls = hulls_of(parts);
-    let h2m = distance_stats(s, &hulls).map_or(f64::INFINITY, |d| d.0);
+/// (mesh → hulls 95th percentile by face planes, outside p99), fractions of the diagonal: the
+/// cheap half of the two-sided estimate, measured first so that a move it already rejects
+/// costs no hull → mesh sampling.
+fn back_and_out(s: &Surface, parts: &[Part], pts: &[P3]) -> (f64, f64) {
     let (back, out): (Vec<f64>, Vec<f64>) = pts
         .par_iter()
         .map(|p| {
             let (mut depth, mut outside, mut inside) = (0.0f64, f64::INFINITY, false);
-            for h in &hulls {
-                let d = h.plane_distance(p);
+            for q in parts {
+                let d = q.hull.plane_distance(p);
                 if d <= 0.0 {
                     inside = true;
                     depth = depth.max(-d);
@@ -69,13 +72,23 @@ fn estimate(s: &Surface, parts: &[Part], pts: &[P3]) -> (f64, f64) {
         })
         .unzip();
     (
-        h2m.max(metrics::percentile(&back, 0.95)),
+        metrics::percentile(&back, 0.95),
         metrics::percentile(&out, 0.99),
     )
 }
 
+/// Hull → mesh 95th percentile of `parts` (fraction of the diagonal), as the object's choice
+/// measures it.
+fn h2m(s: &Surface, parts: &[Part]) -> f64 {
+    distance_stats(s, &hulls_of(parts)).map_or(f64::INFINITY, |d| d.0)
+}
+
 /// Open filled concavities of `parts` in place (at most `rounds` kept moves); returns the
-/// moves kept.
+/// moves kept. `h2m_p95` is the hull → mesh 95th percentile the caller measured on `parts`
+/// (`distance_stats`). Objects whose mesh → hulls side does not exceed it by [`MIN_GAIN`]
+/// are left as they are: no move can lower their two-sided estimate by opening a concavity
+/// alone, and the search would cost CPU for nothing.
+#[allow(clippy::too_many_arguments)]
 pub(super) fn unfill(
     s: &Surface,
     f: &Features,
@@ -84,6 +97,7 @@ pub(super) fn unfill(
     parts: &mut Vec<Part>,
     rounds: usize,
     near: &[f64],
+    h2m_p95: f64,
 ) -> usize {
     let pts = metrics::seen_samples(s, SAMPLES);
     let deep = DEEP * p.tol;
@@ -96,7 +110,11 @@ pub(super) fn unfill(
         return 0;
     }
     let mut fills = fills;
-    let (mut est, mut out) = estimate(s, parts, &pts);
+    let (back, mut out) = back_and_out(s, parts, &pts);
+    if back <= h2m_p95 + MIN_GAIN {
+        return 0;
+    }
+    let mut est = h2m_p95.max(back);
     let mut stuck = vec![false; parts.len()];
     let mut kept = 0;
     for _ in 0..2 * rounds {
@@ -179,8 +197,12 @@ pub(super) fn unfill(
         let (fa, fb) = (fill(&a.hull, &pts, deep), fill(&b.hull, &pts, deep));
         next.extend([a, b, m]);
         next_fill.extend([fa, fb, mf]);
-        let (e, o) = estimate(s, &next, &pts);
-        if e < est - MIN_GAIN && o <= out.max(OUTSIDE * p.tol / s.diag) {
+        let (b, o) = back_and_out(s, &next, &pts);
+        if b >= est - MIN_GAIN || o > out.max(OUTSIDE * p.tol / s.diag) {
+            continue;
+        }
+        let e = h2m(s, &next).max(b);
+        if e < est - MIN_GAIN {
             let mut st: Vec<bool> = (0..parts.len())
                 .filter(|&k| k != w && k != i && k != j)
                 .map(|k| stuck[k])
