@@ -92,7 +92,8 @@
 //! - `object.rs`: step 2 for one object (strategies, quality loop); `parts.rs`: a patch and its
 //!   hull; `memo.rs`: built parts kept per object; `splits.rs`: splitting a patch;
 //!   [`patches`], `cells.rs`: clustering; `rebalance.rs`, `polish.rs`, `refit.rs`, `fit.rs`: the
-//!   moves after the budget is spent; `cover.rs`: the last pass over surface left outside;
+//!   moves after the budget is spent; `unfill.rs`: concavities the chosen patches fill, opened;
+//!   `cover.rs`: the last pass over surface left outside;
 //! - [`geom`]: the mesh surface and hull geometry; [`metrics`]: the two-sided fidelity
 //!   measure; `report.rs`: what the engine tells about each object.
 
@@ -116,6 +117,7 @@ mod scene;
 mod solid;
 mod splits;
 mod star;
+mod unfill;
 
 pub use engine::SceneAware;
 pub use report::{ObjectReport, SceneAwareReport};
@@ -140,7 +142,7 @@ use std::sync::Mutex;
 /// Engine name, recorded in reports and in the cache key.
 pub const NAME: &str = "scene_aware";
 /// Bumped whenever the output for the same input changes (invalidates the cache).
-pub const VERSION: u32 = 38;
+pub const VERSION: u32 = 40;
 
 #[cfg(test)]
 mod tests;

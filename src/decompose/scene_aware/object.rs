@@ -157,7 +157,7 @@ pub(super) fn decompose_object(
         (distance_stats(s, &hulls_of(&r.0)), r)
     };
     let p95 = |d: &Option<(f64, f64)>| d.map_or(f64::INFINITY, |x| x.0);
-    let (dist, (parts, mut report, p)) = strategies
+    let (mut dist, (mut parts, mut report, p)) = strategies
         .par_iter()
         .map(|&st| measured(st))
         .collect::<Vec<_>>()
@@ -165,6 +165,14 @@ pub(super) fn decompose_object(
         .reduce(|a, b| if p95(&b.0) < p95(&a.0) { b } else { a })
         .unwrap_or_else(|| measured(Strategy::Patches));
     report.top_down = p.strategy == Strategy::Planes;
+    // Concavities the chosen patches fill, opened with the budget they have (`unfill.rs`).
+    if effort.polish > 0 && parts.len() >= budget {
+        let h2m = dist.map_or(f64::INFINITY, |d| d.0);
+        report.unfilled = unfill::unfill(s, &feat, &p, opts, &mut parts, UNFILL_ROUNDS, near, h2m);
+        if report.unfilled > 0 {
+            dist = distance_stats(s, &hulls_of(&parts));
+        }
+    }
     // A whole-solid candidate instead when it lies closer at the 95th percentile. A solid the
     // thickness test missed shows as patches that leave it hollow: V-HACD then too.
     let (d_parts, reach) = dist.unwrap_or((0.0, 0.0));
@@ -204,6 +212,8 @@ pub(super) fn hulls_of(parts: &[Part]) -> Vec<Hull> {
 }
 
 pub(super) const P95_SAMPLES: usize = 4000;
+/// Most moves of `unfill.rs` per object.
+const UNFILL_ROUNDS: usize = 8;
 
 /// The parts of one strategy: the closed convex components `fixed` as they are, the remaining
 /// triangles `rest` as k-means patches split by the quality loop, then rebalanced and polished.

@@ -27,6 +27,10 @@ pub struct ObjectReport {
     /// final (see `refit.rs`).
     #[serde(default)]
     pub refitted: usize,
+    /// Patch hulls that filled a concavity, split with a hull freed by a merge elsewhere
+    /// (see `unfill.rs`).
+    #[serde(default)]
+    pub unfilled: usize,
     /// Mesh vertices left deep outside every hull that a hull was grown to take in, last
     /// (see `cover.rs`).
     #[serde(default)]

@@ -1,0 +1,219 @@
+//! Opening filled concavities once the budget is spent (issue #35): a patch hull that spans a
+//! cavity (the YCB duplo's top plate and the tubes under it in one patch, whose hull fills the
+//! hollow underside) keeps the mesh surface under it far from any collision surface, which the
+//! hull → mesh deviation the loops above choose by does not see (the face's nearest mesh point
+//! is on the cavity's rim).
+//!
+//! Entry point: [`unfill`]. Each round measures, on mesh samples (faces buried in the mesh's
+//! own material left out, `metrics::seen_samples`), how much surface each free hull holds
+//! deeper than twice the tolerance (the sum of those depths); takes the hull that holds most;
+//! splits its patch the way (of [`split_ways`]) whose halves hold least; and frees a hull for
+//! it by merging the adjacent pair of patches whose merged hull deviates least and holds no
+//! more than the two did. The move is kept only when the object's two-sided estimate (the
+//! larger of the hull → mesh 95th percentile and the mesh → hulls one by face planes) drops
+//! by [`MIN_GAIN`] of the diagonal, and the surface outside every hull does not grow at the
+//! 99th percentile. Hull count, pins and lifts are kept as in the rebalancing. Objects whose
+//! mesh → hulls side does not already exceed the hull → mesh one are skipped, and a move's
+//! hull → mesh percentile is measured only when its mesh → hulls side and outside depth pass
+//! (the CPU limit of #35: at most 5 % more than without the pass).
+
+use super::geom::Surface;
+use super::metrics;
+use super::object::{distance_stats, hulls_of};
+use super::patches::Features;
+use super::rebalance::{adjacency, adjacent_pairs, lift, pinned, union};
+use super::splits::split_ways;
+use super::{build_part, Params, Part, CONTACT_DEV};
+use crate::decompose::{DecomposeOptions, Hull};
+use crate::mesh::P3;
+use rayon::prelude::*;
+
+/// Mesh samples the fill is measured on.
+const SAMPLES: usize = 4000;
+/// Depth (in tolerances) below which surface inside a hull is not counted as filled.
+const DEEP: f64 = 2.0;
+/// Least drop of the two-sided estimate (fraction of the diagonal) for a move to be kept.
+const MIN_GAIN: f64 = 0.0005;
+/// Outside depth (99th percentile, in tolerances) a move may bring the object to when it was
+/// below: `cover.rs` takes in what lies deeper than 0.3 % of the diagonal afterwards.
+const OUTSIDE: f64 = 0.6;
+
+/// Sum of the depths of the samples deeper than `deep` inside `h` (m).
+fn fill(h: &Hull, pts: &[P3], deep: f64) -> f64 {
+    pts.iter()
+        .filter(|p| (0..3).all(|a| h.aabb.min[a] <= p[a] && p[a] <= h.aabb.max[a]))
+        .map(|p| -h.plane_distance(p))
+        .filter(|&d| d > deep)
+        .sum()
+}
+
+/// (mesh → hulls 95th percentile by face planes, outside p99), fractions of the diagonal: the
+/// cheap half of the two-sided estimate, measured first so that a move it already rejects
+/// costs no hull → mesh sampling.
+fn back_and_out(s: &Surface, parts: &[Part], pts: &[P3]) -> (f64, f64) {
+    let (back, out): (Vec<f64>, Vec<f64>) = pts
+        .par_iter()
+        .map(|p| {
+            let (mut depth, mut outside, mut inside) = (0.0f64, f64::INFINITY, false);
+            for q in parts {
+                let d = q.hull.plane_distance(p);
+                if d <= 0.0 {
+                    inside = true;
+                    depth = depth.max(-d);
+                } else {
+                    outside = outside.min(d);
+                }
+            }
+            if inside {
+                (depth / s.diag, 0.0)
+            } else {
+                (outside / s.diag, outside / s.diag)
+            }
+        })
+        .unzip();
+    (
+        metrics::percentile(&back, 0.95),
+        metrics::percentile(&out, 0.99),
+    )
+}
+
+/// Hull → mesh 95th percentile of `parts` (fraction of the diagonal), as the object's choice
+/// measures it.
+fn h2m(s: &Surface, parts: &[Part]) -> f64 {
+    distance_stats(s, &hulls_of(parts)).map_or(f64::INFINITY, |d| d.0)
+}
+
+/// Open filled concavities of `parts` in place (at most `rounds` kept moves); returns the
+/// moves kept. `h2m_p95` is the hull → mesh 95th percentile the caller measured on `parts`
+/// (`distance_stats`). Objects whose mesh → hulls side does not exceed it by [`MIN_GAIN`]
+/// are left as they are: no move can lower their two-sided estimate by opening a concavity
+/// alone, and the search would cost CPU for nothing.
+#[allow(clippy::too_many_arguments)]
+pub(super) fn unfill(
+    s: &Surface,
+    f: &Features,
+    p: &Params,
+    opts: &DecomposeOptions,
+    parts: &mut Vec<Part>,
+    rounds: usize,
+    near: &[f64],
+    h2m_p95: f64,
+) -> usize {
+    let pts = metrics::seen_samples(s, SAMPLES);
+    let deep = DEEP * p.tol;
+    let is_pinned = |q: &Part| pinned(near, &q.tris, q.dev, p, opts);
+    let fills: Vec<f64> = parts
+        .par_iter()
+        .map(|q| fill(&q.hull, &pts, deep))
+        .collect();
+    if fills.iter().all(|&x| x <= 0.0) {
+        return 0;
+    }
+    let mut fills = fills;
+    let (back, mut out) = back_and_out(s, parts, &pts);
+    if back <= h2m_p95 + MIN_GAIN {
+        return 0;
+    }
+    let mut est = h2m_p95.max(back);
+    let mut stuck = vec![false; parts.len()];
+    let mut kept = 0;
+    for _ in 0..2 * rounds {
+        if kept >= rounds {
+            break;
+        }
+        let Some(w) = (0..parts.len())
+            .filter(|&i| {
+                !stuck[i] && fills[i] > 0.0 && parts[i].tris.len() >= 2 && !is_pinned(&parts[i])
+            })
+            .max_by(|&i, &j| fills[i].total_cmp(&fills[j]).then(j.cmp(&i)))
+        else {
+            break;
+        };
+        stuck[w] = true;
+        // The split whose halves hold least.
+        let halves: Vec<Option<(Part, Part, f64)>> = split_ways(s, f, p, &parts[w], false)
+            .into_par_iter()
+            .map(|(a, b)| {
+                let cuts = parts[w].cuts.clone();
+                let a = build_part(s, p, opts, a, cuts.clone())?;
+                let b = build_part(s, p, opts, b, cuts)?;
+                let held = fill(&a.hull, &pts, deep) + fill(&b.hull, &pts, deep);
+                Some((a, b, held))
+            })
+            .collect();
+        let Some((a, b, held)) = halves
+            .into_iter()
+            .flatten()
+            .reduce(|x, y| if y.2 < x.2 { y } else { x })
+        else {
+            continue;
+        };
+        if held >= 0.5 * fills[w] {
+            continue;
+        }
+        // The merge that frees a hull: least deviation, holding no more than its two did,
+        // lifting nothing a neighbour may stand on.
+        let adj = adjacency(s, parts);
+        let pairs = adjacent_pairs(&adj, w);
+        let merges: Vec<Option<(Part, f64, usize, usize)>> = pairs
+            .par_iter()
+            .map(|&(i, j)| {
+                if is_pinned(&parts[i]) || is_pinned(&parts[j]) {
+                    return None;
+                }
+                let m = build_part(
+                    s,
+                    p,
+                    opts,
+                    union(&parts[i], &parts[j]),
+                    parts[i].cuts.clone(),
+                )?;
+                let top = lift(s, &parts[i].hull, &parts[i].tris)
+                    .max(lift(s, &parts[j].hull, &parts[j].tris))
+                    .max(CONTACT_DEV * p.tol);
+                let mf = fill(&m.hull, &pts, deep);
+                (lift(s, &m.hull, &m.tris) <= top
+                    && mf - fills[i] - fills[j] < 0.5 * (fills[w] - held)
+                    && !is_pinned(&m))
+                .then_some((m, mf, i, j))
+            })
+            .collect();
+        let Some((m, mf, i, j)) =
+            merges
+                .into_iter()
+                .flatten()
+                .reduce(|x, y| if y.0.dev < x.0.dev { y } else { x })
+        else {
+            continue;
+        };
+        let mut next: Vec<Part> = Vec::with_capacity(parts.len());
+        let mut next_fill = Vec::with_capacity(parts.len());
+        for (k, q) in parts.iter().enumerate() {
+            if k != w && k != i && k != j {
+                next.push(q.clone());
+                next_fill.push(fills[k]);
+            }
+        }
+        let (fa, fb) = (fill(&a.hull, &pts, deep), fill(&b.hull, &pts, deep));
+        next.extend([a, b, m]);
+        next_fill.extend([fa, fb, mf]);
+        let (b, o) = back_and_out(s, &next, &pts);
+        if b >= est - MIN_GAIN || o > out.max(OUTSIDE * p.tol / s.diag) {
+            continue;
+        }
+        let e = h2m(s, &next).max(b);
+        if e < est - MIN_GAIN {
+            let mut st: Vec<bool> = (0..parts.len())
+                .filter(|&k| k != w && k != i && k != j)
+                .map(|k| stuck[k])
+                .collect();
+            st.extend([false, false, false]);
+            *parts = next;
+            fills = next_fill;
+            stuck = st;
+            (est, out) = (e, o);
+            kept += 1;
+        }
+    }
+    kept
+}
