@@ -46,7 +46,7 @@
 
 use super::geom::{sample_hull, Surface};
 use super::patches::Features;
-use super::rebalance::{adjacency, adjacent_pairs, lift, lifts_by_id, pinned, union};
+use super::rebalance::{adjacency, adjacent_pairs, build_merge, lift, lifts_by_id, pinned, union};
 use super::{build_part, closest_splits, hulls_of, metrics, split_ways, Params, Part, CONTACT_DEV};
 use crate::decompose::{DecomposeOptions, Hull};
 use crate::mesh::Aabb;
@@ -315,13 +315,7 @@ pub(super) fn polish(
                 if is_pinned(&parts[i]) || is_pinned(&parts[j]) {
                     return None;
                 }
-                let m = build_part(
-                    s,
-                    p,
-                    opts,
-                    union(&parts[i], &parts[j]),
-                    parts[i].cuts.clone(),
-                )?;
+                let m = build_merge(s, p, opts, &parts[i], &parts[j])?;
                 (lift(s, &m.hull, &m.tris) <= top(i, j) && !is_pinned(&m)).then(|| sampled(m))
             })
             .collect();

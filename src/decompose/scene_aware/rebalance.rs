@@ -92,13 +92,7 @@ pub(super) fn rebalance(
         let built: Vec<Option<(Part, f64)>> = missing
             .par_iter()
             .map(|&(i, j)| {
-                let m = build_part(
-                    s,
-                    p,
-                    opts,
-                    union(&parts[i], &parts[j]),
-                    parts[i].cuts.clone(),
-                )?;
+                let m = build_merge(s, p, opts, &parts[i], &parts[j])?;
                 let l = lift(s, &m.hull, &m.tris);
                 Some((m, l))
             })
@@ -252,6 +246,18 @@ pub(super) fn adjacent_pairs(adj: &[Vec<usize>], w: usize) -> Vec<(usize, usize)
                 .map(move |&j| (i, j))
         })
         .collect()
+}
+
+/// The part two patches make together, with the first one's cuts (every merge keeps them), or
+/// `None` when their triangles make no part.
+pub(super) fn build_merge(
+    s: &Surface,
+    p: &Params,
+    opts: &DecomposeOptions,
+    a: &Part,
+    b: &Part,
+) -> Option<Part> {
+    build_part(s, p, opts, union(a, b), a.cuts.clone())
 }
 
 /// The triangles of two patches, ascending.

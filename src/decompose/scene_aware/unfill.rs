@@ -21,7 +21,7 @@ use super::geom::Surface;
 use super::metrics;
 use super::object::{distance_stats, hulls_of};
 use super::patches::Features;
-use super::rebalance::{adjacency, adjacent_pairs, lift, pinned, union};
+use super::rebalance::{adjacency, adjacent_pairs, build_merge, lift, pinned};
 use super::splits::split_ways;
 use super::{build_part, Params, Part, CONTACT_DEV};
 use crate::decompose::{DecomposeOptions, Hull};
@@ -161,13 +161,7 @@ pub(super) fn unfill(
                 if is_pinned(&parts[i]) || is_pinned(&parts[j]) {
                     return None;
                 }
-                let m = build_part(
-                    s,
-                    p,
-                    opts,
-                    union(&parts[i], &parts[j]),
-                    parts[i].cuts.clone(),
-                )?;
+                let m = build_merge(s, p, opts, &parts[i], &parts[j])?;
                 let top = lift(s, &parts[i].hull, &parts[i].tris)
                     .max(lift(s, &parts[j].hull, &parts[j].tris))
                     .max(CONTACT_DEV * p.tol);
