@@ -131,23 +131,25 @@ pub(super) fn unfill(
         };
         stuck[w] = true;
         // The split whose halves hold least.
-        let halves: Vec<Option<(Part, Part, f64)>> = split_ways(s, f, p, &parts[w], false)
+        let halves: Vec<Option<(Part, Part, f64, f64)>> = split_ways(s, f, p, &parts[w], false)
             .into_par_iter()
             .map(|(a, b)| {
                 let cuts = parts[w].cuts.clone();
                 let a = build_part(s, p, opts, a, cuts.clone())?;
                 let b = build_part(s, p, opts, b, cuts)?;
-                let held = fill(&a.hull, &pts, deep) + fill(&b.hull, &pts, deep);
-                Some((a, b, held))
+                let (fa, fb) = (fill(&a.hull, &pts, deep), fill(&b.hull, &pts, deep));
+                Some((a, b, fa, fb))
             })
             .collect();
-        let Some((a, b, held)) = halves
-            .into_iter()
-            .flatten()
-            .reduce(|x, y| if y.2 < x.2 { y } else { x })
+        let Some((a, b, fa, fb)) =
+            halves
+                .into_iter()
+                .flatten()
+                .reduce(|x, y| if y.2 + y.3 < x.2 + x.3 { y } else { x })
         else {
             continue;
         };
+        let held = fa + fb;
         if held >= 0.5 * fills[w] {
             continue;
         }
@@ -188,7 +190,6 @@ pub(super) fn unfill(
                 next_fill.push(fills[k]);
             }
         }
-        let (fa, fb) = (fill(&a.hull, &pts, deep), fill(&b.hull, &pts, deep));
         next.extend([a, b, m]);
         next_fill.extend([fa, fb, mf]);
         let (b, o) = back_and_out(s, &next, &pts);
