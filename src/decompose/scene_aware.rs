@@ -110,6 +110,7 @@ mod parts;
 pub mod patches;
 mod polish;
 mod project;
+mod race;
 mod rebalance;
 mod refit;
 mod report;
@@ -142,7 +143,7 @@ use std::sync::Mutex;
 /// Engine name, recorded in reports and in the cache key.
 pub const NAME: &str = "scene_aware";
 /// Bumped whenever the output for the same input changes (invalidates the cache).
-pub const VERSION: u32 = 40;
+pub const VERSION: u32 = 41;
 
 #[cfg(test)]
 mod tests;
