@@ -120,7 +120,7 @@ fn heavy_item_on_light_one_agrees_only_with_the_load_rule() {
         on.heavily_loaded, on.passed, on.seconds, off.passed, off.seconds, off.reasons
     );
     // (a) the rule names the light body, and only it.
-    assert_eq!(on.heavily_loaded, [light.clone()]);
+    assert_eq!(on.heavily_loaded, [light]);
     // (c) without it Rapier squeezes the scissors out and the box falls off.
     assert!(off.heavily_loaded.is_empty());
     assert!(!off.passed, "the rule off passed: {off:?}");
