@@ -102,6 +102,7 @@ mod contacts;
 mod cover;
 mod engine;
 mod fit;
+mod fps;
 pub mod geom;
 mod memo;
 pub mod metrics;
