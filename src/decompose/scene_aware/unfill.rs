@@ -37,43 +37,6 @@ const MIN_GAIN: f64 = 0.0005;
 /// Outside depth (99th percentile, in tolerances) a move may bring the object to when it was
 /// below: `cover.rs` takes in what lies deeper than 0.3 % of the diagonal afterwards.
 const OUTSIDE: f64 = 0.6;
-/// Merges tried, least deviating first, to free the hull a split needs.
-const MERGES: usize = 3;
-
-/// Cuts of `part`'s patch through the centroid of the samples its hull holds deeper than
-/// `deep`, normal to each axis: a patch whose hull spans a cavity (the duplo's top plate with
-/// the tubes under it) is cut at the cavity, where an area-median cut need not fall. Ways
-/// already in `ways` are left out.
-fn held_cuts(
-    s: &Surface,
-    part: &Part,
-    pts: &[P3],
-    deep: f64,
-    ways: &[(Vec<u32>, Vec<u32>)],
-) -> Vec<(Vec<u32>, Vec<u32>)> {
-    let h = &part.hull;
-    let held: Vec<&P3> = pts
-        .iter()
-        .filter(|p| (0..3).all(|a| h.aabb.min[a] <= p[a] && p[a] <= h.aabb.max[a]))
-        .filter(|p| -h.plane_distance(p) > deep)
-        .collect();
-    if held.is_empty() {
-        return Vec::new();
-    }
-    let n = held.len() as f64;
-    let c: [f64; 3] = std::array::from_fn(|a| held.iter().map(|p| p[a]).sum::<f64>() / n);
-    let mut cuts: Vec<(Vec<u32>, Vec<u32>)> = Vec::new();
-    for (a, &ca) in c.iter().enumerate() {
-        let (lo, hi): (Vec<u32>, Vec<u32>) = part
-            .tris
-            .iter()
-            .partition(|&&t| s.tri_centroid[t as usize][a] < ca);
-        if !lo.is_empty() && !hi.is_empty() && !ways.iter().chain(&cuts).any(|w| w.0 == lo) {
-            cuts.push((lo, hi));
-        }
-    }
-    cuts
-}
 
 /// Sum of the depths of the samples deeper than `deep` inside `h` (m).
 fn fill(h: &Hull, pts: &[P3], deep: f64) -> f64 {
@@ -114,23 +77,6 @@ fn back_and_out(s: &Surface, parts: &[Part], pts: &[P3]) -> (f64, f64) {
     )
 }
 
-/// Mesh → hulls 95th percentile of `parts` (fraction of the diagonal) on `pts`, to the
-/// boundary of the union of the hulls as the bench and the report measure it. The face-plane
-/// depth of [`back_and_out`] is a lower bound of it that two overlapping halves of a filling
-/// hull fool: each holds the cavity less deep while their union fills it as before (a cut
-/// through the duplo's and TROCHILUS's cavities read 0.4 points better by face planes and
-/// measured 0.4 points worse on TROCHILUS).
-fn back_to_union(s: &Surface, parts: &[Part], pts: &[P3]) -> f64 {
-    let Some(boundary) = metrics::union_boundary(&hulls_of(parts), s.diag) else {
-        return f64::INFINITY;
-    };
-    let d: Vec<f64> = pts
-        .par_iter()
-        .map(|p| boundary.distance(p) / s.diag)
-        .collect();
-    metrics::percentile(&d, 0.95)
-}
-
 /// Hull → mesh 95th percentile of `parts` (fraction of the diagonal), as the object's choice
 /// measures it.
 fn h2m(s: &Surface, parts: &[Part]) -> f64 {
@@ -168,7 +114,7 @@ pub(super) fn unfill(
     if back <= h2m_p95 + MIN_GAIN {
         return 0;
     }
-    let mut est = h2m_p95.max(back_to_union(s, parts, &pts));
+    let mut est = h2m_p95.max(back);
     let mut stuck = vec![false; parts.len()];
     let mut kept = 0;
     for _ in 0..2 * rounds {
@@ -185,9 +131,7 @@ pub(super) fn unfill(
         };
         stuck[w] = true;
         // The split whose halves hold least.
-        let mut ways = split_ways(s, f, p, &parts[w], false);
-        ways.extend(held_cuts(s, &parts[w], &pts, deep, &ways));
-        let halves: Vec<Option<(Part, Part, f64, f64)>> = ways
+        let halves: Vec<Option<(Part, Part, f64, f64)>> = split_ways(s, f, p, &parts[w], false)
             .into_par_iter()
             .map(|(a, b)| {
                 let cuts = parts[w].cuts.clone();
@@ -230,46 +174,41 @@ pub(super) fn unfill(
                 .then_some((m, mf, i, j))
             })
             .collect();
-        // Least deviating first (ties: the earlier pair); the next ones when it fails the
-        // checks below (TROCHILUS's best pair failed the outside bound in every try).
-        let mut merges: Vec<(Part, f64, usize, usize)> = merges.into_iter().flatten().collect();
-        merges.sort_by(|x, y| x.0.dev.total_cmp(&y.0.dev));
-        merges.truncate(MERGES);
-        let tried = merges.into_iter().find_map(|(m, mf, i, j)| {
-            let mut next: Vec<Part> = Vec::with_capacity(parts.len());
-            let mut next_fill = Vec::with_capacity(parts.len());
-            for (k, q) in parts.iter().enumerate() {
-                if k != w && k != i && k != j {
-                    next.push(q.clone());
-                    next_fill.push(fills[k]);
-                }
-            }
-            next.extend([a.clone(), b.clone(), m]);
-            next_fill.extend([fa, fb, mf]);
-            let (back, o) = back_and_out(s, &next, &pts);
-            if back >= est - MIN_GAIN || o > out.max(OUTSIDE * p.tol / s.diag) {
-                return None;
-            }
-            let back = back_to_union(s, &next, &pts);
-            if back >= est - MIN_GAIN {
-                return None;
-            }
-            let e = h2m(s, &next).max(back);
-            (e < est - MIN_GAIN).then_some((next, next_fill, e, o, i, j))
-        });
-        let Some((next, next_fill, e, o, i, j)) = tried else {
+        let Some((m, mf, i, j)) =
+            merges
+                .into_iter()
+                .flatten()
+                .reduce(|x, y| if y.0.dev < x.0.dev { y } else { x })
+        else {
             continue;
         };
-        let mut st: Vec<bool> = (0..parts.len())
-            .filter(|&k| k != w && k != i && k != j)
-            .map(|k| stuck[k])
-            .collect();
-        st.extend([false, false, false]);
-        *parts = next;
-        fills = next_fill;
-        stuck = st;
-        (est, out) = (e, o);
-        kept += 1;
+        let mut next: Vec<Part> = Vec::with_capacity(parts.len());
+        let mut next_fill = Vec::with_capacity(parts.len());
+        for (k, q) in parts.iter().enumerate() {
+            if k != w && k != i && k != j {
+                next.push(q.clone());
+                next_fill.push(fills[k]);
+            }
+        }
+        next.extend([a, b, m]);
+        next_fill.extend([fa, fb, mf]);
+        let (b, o) = back_and_out(s, &next, &pts);
+        if b >= est - MIN_GAIN || o > out.max(OUTSIDE * p.tol / s.diag) {
+            continue;
+        }
+        let e = h2m(s, &next).max(b);
+        if e < est - MIN_GAIN {
+            let mut st: Vec<bool> = (0..parts.len())
+                .filter(|&k| k != w && k != i && k != j)
+                .map(|k| stuck[k])
+                .collect();
+            st.extend([false, false, false]);
+            *parts = next;
+            fills = next_fill;
+            stuck = st;
+            (est, out) = (e, o);
+            kept += 1;
+        }
     }
     kept
 }
