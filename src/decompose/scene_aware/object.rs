@@ -236,29 +236,32 @@ pub(super) fn grow_parts(
     effort: Effort,
     near: &[f64],
 ) -> (Vec<Part>, ObjectReport) {
-    let at = grow_to_quality(s, feat, p, opts, fixed, rest, budget);
-    let at = grow_rebalanced(s, feat, p, opts, at, budget, effort, near);
-    grow_from_checkpoint(s, feat, p, opts, at, budget, effort, near)
+    let c = race::Ctx {
+        s,
+        feat,
+        opts,
+        fixed,
+        rest,
+        budget,
+        effort,
+        near,
+    };
+    let at = grow_to_quality(&c, p);
+    let at = grow_rebalanced(&c, p, at);
+    grow_from_checkpoint(&c, p, at)
 }
 
 /// [`grow_parts`] up to the strategy race's first checkpoint (see `race.rs`): the k-means
 /// patches and the quality loop.
-pub(super) fn grow_to_quality(
-    s: &Surface,
-    feat: &patches::Features,
-    p: &Params,
-    opts: &DecomposeOptions,
-    fixed: &[Part],
-    rest: &[u32],
-    budget: usize,
-) -> (Vec<Part>, ObjectReport) {
+pub(super) fn grow_to_quality(c: &race::Ctx, p: &Params) -> (Vec<Part>, ObjectReport) {
+    let (s, feat, opts, budget) = (c.s, c.feat, c.opts, c.budget);
     let mut report = ObjectReport::default();
-    let mut parts = fixed.to_vec();
-    if !rest.is_empty() {
+    let mut parts = c.fixed.to_vec();
+    if !c.rest.is_empty() {
         let k0 = p
             .strategy
             .initial_patches(budget.saturating_sub(parts.len()));
-        let groups = patches::kmeans(s, feat, rest, k0, p.lambda, 16);
+        let groups = patches::kmeans(s, feat, c.rest, k0, p.lambda, 16);
         parts.extend(
             groups
                 .into_par_iter()
@@ -272,42 +275,37 @@ pub(super) fn grow_to_quality(
 
 /// [`grow_parts`] from [`grow_to_quality`] to the race's second checkpoint: the rebalancing,
 /// when the budget is spent.
-#[allow(clippy::too_many_arguments)]
 pub(super) fn grow_rebalanced(
-    s: &Surface,
-    feat: &patches::Features,
+    c: &race::Ctx,
     p: &Params,
-    opts: &DecomposeOptions,
     (mut parts, mut report): (Vec<Part>, ObjectReport),
-    budget: usize,
-    effort: Effort,
-    near: &[f64],
 ) -> (Vec<Part>, ObjectReport) {
-    if parts.len() >= budget {
-        report.rebalance_rounds =
-            rebalance::rebalance(s, feat, p, opts, &mut parts, effort.rebalance, near);
+    if parts.len() >= c.budget {
+        report.rebalance_rounds = rebalance::rebalance(
+            c.s,
+            c.feat,
+            p,
+            c.opts,
+            &mut parts,
+            c.effort.rebalance,
+            c.near,
+        );
     }
     (parts, report)
 }
 
 /// The rest of [`grow_parts`] after [`grow_rebalanced`]: the polishing (budget spent) and
 /// the refit; the parts' memo is emptied.
-#[allow(clippy::too_many_arguments)]
 pub(super) fn grow_from_checkpoint(
-    s: &Surface,
-    feat: &patches::Features,
+    c: &race::Ctx,
     p: &Params,
-    opts: &DecomposeOptions,
     (mut parts, mut report): (Vec<Part>, ObjectReport),
-    budget: usize,
-    effort: Effort,
-    near: &[f64],
 ) -> (Vec<Part>, ObjectReport) {
-    if parts.len() >= budget && effort.polish > 0 {
+    if parts.len() >= c.budget && c.effort.polish > 0 {
         (report.trimmed_patches, report.polish_rounds) =
-            polish::polish(s, feat, p, opts, &mut parts, effort.polish, near);
+            polish::polish(c.s, c.feat, p, c.opts, &mut parts, c.effort.polish, c.near);
     }
-    report.refitted = refit::refit(s, p, opts, &mut parts, near);
+    report.refitted = refit::refit(c.s, p, c.opts, &mut parts, c.near);
     p.memo.clear();
     (parts, report)
 }

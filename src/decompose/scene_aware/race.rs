@@ -92,7 +92,7 @@ pub(super) fn race(c: &Ctx, strategies: &[Strategy]) -> Vec<Run> {
         .par_iter()
         .map(|&st| {
             let p = Params::new(s, c.opts, st);
-            let r = grow_to_quality(s, c.feat, &p, c.opts, c.fixed, c.rest, c.budget);
+            let r = grow_to_quality(c, &p);
             (r, p)
         })
         .collect();
@@ -110,7 +110,7 @@ pub(super) fn race(c: &Ctx, strategies: &[Strategy]) -> Vec<Run> {
         .zip(d1)
         .filter(|(_, d)| !behind(*d, lead1, m1))
         .map(|((r, p), _)| {
-            let r = grow_rebalanced(s, c.feat, &p, c.opts, r, c.budget, c.effort, c.near);
+            let r = grow_rebalanced(c, &p, r);
             (r, p)
         })
         .collect();
@@ -121,7 +121,7 @@ pub(super) fn race(c: &Ctx, strategies: &[Strategy]) -> Vec<Run> {
         .zip(d2)
         .filter(|(_, d)| !behind(*d, lead2, m2))
         .map(|((r, p), _)| {
-            let r = grow_from_checkpoint(s, c.feat, &p, c.opts, r, c.budget, c.effort, c.near);
+            let r = grow_from_checkpoint(c, &p, r);
             let fin = distance_stats(s, &hulls_of(&r.0));
             (fin, (r.0, r.1, p))
         })
