@@ -324,7 +324,7 @@ pub(super) fn polish(
                 if is_pinned(&parts[i]) || is_pinned(&parts[j]) {
                     return None;
                 }
-                let m = build_merge(s, p, opts, &parts[i], &parts[j])?;
+                let m = build_merge(s, p, opts, &parts[i], &parts[j], f64::INFINITY)?;
                 (lift(s, &m.hull, &m.tris) <= top(i, j) && !is_pinned(&m)).then(|| sampled(m))
             })
             .collect();

@@ -33,7 +33,7 @@
 
 use super::geom::Surface;
 use super::patches::Features;
-use super::{build_part, build_part_below, split, Params, Part, CONTACT_DEV, SUPPORT_NZ};
+use super::{build_part_below, split, Params, Part, CONTACT_DEV, SUPPORT_NZ};
 use crate::decompose::DecomposeOptions;
 use rayon::prelude::*;
 use std::collections::BTreeMap;
@@ -96,8 +96,7 @@ pub(super) fn rebalance(
         let built: Vec<Option<(Part, f64)>> = missing
             .par_iter()
             .map(|&(i, j)| {
-                let tris = union(&parts[i], &parts[j]);
-                let m = build_part_below(s, p, opts, tris, parts[i].cuts.clone(), worst)?;
+                let m = build_merge(s, p, opts, &parts[i], &parts[j], worst)?;
                 let l = lift(s, &m.hull, &m.tris);
                 Some((m, l))
             })
@@ -265,15 +264,17 @@ pub(super) fn adjacent_pairs(adj: &[Vec<usize>], w: usize) -> Vec<(usize, usize)
 }
 
 /// The part two patches make together, with the first one's cuts (every merge keeps them), or
-/// `None` when their triangles make no part.
+/// `None` when their triangles make no part or it deviates `bound` or more (see
+/// [`build_part_below`]; `f64::INFINITY`: any deviation).
 pub(super) fn build_merge(
     s: &Surface,
     p: &Params,
     opts: &DecomposeOptions,
     a: &Part,
     b: &Part,
+    bound: f64,
 ) -> Option<Part> {
-    build_part(s, p, opts, union(a, b), a.cuts.clone())
+    build_part_below(s, p, opts, union(a, b), a.cuts.clone(), bound)
 }
 
 /// The triangles of two patches, ascending.
