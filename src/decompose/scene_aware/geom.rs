@@ -8,7 +8,7 @@ use crate::mesh::{to_dvec, triangle_area, Aabb, Mesh, P3, V3};
 use crate::rng::Rng;
 use parry3d_f64::math::{Pose, Vector};
 use parry3d_f64::partitioning::{BvhNode, TraversalAction};
-use parry3d_f64::query::{PointQuery, Ray, RayCast};
+use parry3d_f64::query::{Ray, RayCast};
 use parry3d_f64::shape::{ConvexPolyhedron, TriMesh, TriMeshFlags};
 use rayon::prelude::*;
 
@@ -18,7 +18,7 @@ pub struct Surface {
     pub mesh: Mesh,
     pub tri: TriMesh,
     /// The corners of `tri`'s triangles, by its BVH's leaf index (see [`Surface::within`]).
-    corners: Vec<[Vector; 3]>,
+    pub(super) corners: Vec<[Vector; 3]>,
     /// Those triangles by grid cell: a first guess for [`Surface::within`].
     cells: Cells,
     /// Watertight and consistently oriented: inside tests are meaningful.
@@ -106,15 +106,14 @@ impl Surface {
         })
     }
 
-    /// Unsigned distance from `p` to the surface (parry's projection).
+    /// Unsigned distance from `p` to the surface (parry's projection, see [`Surface::project`]).
     pub fn distance(&self, p: &P3) -> f64 {
         (self.closest(p) - p).norm()
     }
 
-    /// The point of the surface closest to `p` (parry's projection).
+    /// The point of the surface closest to `p` (parry's projection, see [`Surface::project`]).
     pub fn closest(&self, p: &P3) -> P3 {
-        let proj = self.tri.project_point(&Pose::identity(), to_dvec(p), false);
-        crate::mesh::from_dvec(proj.point)
+        crate::mesh::from_dvec(self.project(to_dvec(p)).point)
     }
 
     /// Whether some point of the surface is within `r` of `p`: the triangles of `p`'s grid
@@ -173,10 +172,7 @@ impl Surface {
             return self.distance(p) > r;
         }
         let bound = r * (1.0 + WITHIN_MARGIN);
-        match self
-            .tri
-            .project_point_with_max_dist(&Pose::identity(), q, false, bound)
-        {
+        match self.project_within(q, bound) {
             Some(proj) => (crate::mesh::from_dvec(proj.point) - p).norm() > r,
             None => true,
         }
@@ -219,11 +215,7 @@ impl Surface {
 
     /// Whether `p` is inside the closed mesh (always `false` for open meshes).
     pub fn contains(&self, p: &P3) -> bool {
-        self.closed
-            && self
-                .tri
-                .project_point(&Pose::identity(), to_dvec(p), false)
-                .is_inside
+        self.closed && self.project(to_dvec(p)).is_inside
     }
 
     /// Generalised winding number of the surface about `p` (the solid angle its triangles
