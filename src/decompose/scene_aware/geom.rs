@@ -431,7 +431,8 @@ pub fn distinct_sorted(v: &[u32]) -> Vec<u32> {
         let i = (x - lo) as usize;
         bits[i >> 6] |= 1 << (i & 63);
     }
-    let mut out = Vec::new();
+    // Sized once: pushing into an empty vector reallocated it about log2(n) times.
+    let mut out = Vec::with_capacity(bits.iter().map(|b| b.count_ones() as usize).sum());
     for (w, &b) in bits.iter().enumerate() {
         let mut b = b;
         while b != 0 {
