@@ -115,6 +115,7 @@ mod race;
 mod rebalance;
 mod refit;
 mod report;
+mod resolution;
 mod scene;
 mod solid;
 mod splits;
