@@ -115,7 +115,6 @@ mod race;
 mod rebalance;
 mod refit;
 mod report;
-mod resolution;
 mod scene;
 mod solid;
 mod splits;

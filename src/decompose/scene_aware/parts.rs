@@ -18,8 +18,6 @@ pub(super) struct Params {
     pub(super) strategy: Strategy,
     /// Parts built so far (see [`build_part`]).
     pub(super) memo: Memo,
-    /// Each vertex's stand-in for the search's per-vertex work (see [`resolution`]).
-    pub(super) rep: Option<std::sync::Arc<[u32]>>,
 }
 
 /// How an object's patches are found. For an object alone, [`decompose_object`] runs both and
@@ -98,7 +96,6 @@ impl Params {
             n_outer: (opts.max_vertices / 2).max(4),
             strategy,
             memo: Memo::default(),
-            rep: super::resolution::representatives(s, super::resolution::eps()),
         }
     }
 }
@@ -254,9 +251,8 @@ pub(super) fn build_new_part(
     let axis = s.tri_normal[axis_t as usize];
     let (mut pos, mut neg): (Vec<u32>, Vec<u32>) = (Vec::new(), Vec::new());
     let (mut a_pos, mut a_neg) = (0.0, 0.0);
-    let r = |k: u32| p.rep.as_ref().map_or(k, |r| r[k as usize]);
     for &t in &tris {
-        let tri = s.mesh.triangles[t as usize].map(r);
+        let tri = s.mesh.triangles[t as usize];
         if s.tri_normal[t as usize].dot(&axis) >= 0.0 {
             pos.extend(tri);
             a_pos += s.tri_area[t as usize];
@@ -292,7 +288,7 @@ pub(super) fn build_new_part(
         for &t in &tris {
             let w = s.tri_normal[t as usize] * s.tri_area[t as usize];
             for k in s.mesh.triangles[t as usize] {
-                if let Ok(i) = vs.binary_search(&r(k)) {
+                if let Ok(i) = vs.binary_search(&k) {
                     vn[i] += w;
                 }
             }
