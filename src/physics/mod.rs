@@ -99,6 +99,12 @@ pub struct SettleOptions {
     /// PGS sweeps per substep of an island with a heavily loaded body (at least
     /// `pgs_iterations`).
     pub loaded_pgs_iterations: usize,
+    /// A heavily loaded body's contacts are recomputed every step, never recycled (see
+    /// [`Self::contact_recycling`] and [`load_ratio`]): a recycled contact keeps its points and
+    /// normal while the pair moves up to `contact_recycle_distance`, and under a load of
+    /// `load_ratio` times its own weight that stale lever decides whether the light body tips.
+    /// Pairs without a loaded body recycle as before. `false`: recycled like every pair.
+    pub loaded_fresh_contacts: bool,
     /// Gravitational acceleration along −z (m/s²).
     pub gravity: f64,
     /// Cap on the settle phase (s): it ends earlier when every dynamic body sleeps. 6 s: a
@@ -215,6 +221,7 @@ impl Default for SettleOptions {
             load_ratio: 10.0,
             loaded_solver_iterations: 8,
             loaded_pgs_iterations: 4,
+            loaded_fresh_contacts: true,
             gravity: 9.81,
             settle_max_time: 6.0,
             rest_time: 1.0,
