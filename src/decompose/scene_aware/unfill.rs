@@ -36,6 +36,9 @@ use crate::decompose::{DecomposeOptions, Hull};
 use crate::mesh::P3;
 use rayon::prelude::*;
 
+#[cfg(test)]
+mod tests;
+
 /// Mesh samples the fill is measured on.
 const SAMPLES: usize = 4000;
 /// Depth (in tolerances) below which surface inside a hull is not counted as filled.
