@@ -144,7 +144,7 @@ use std::sync::Mutex;
 /// Engine name, recorded in reports and in the cache key.
 pub const NAME: &str = "scene_aware";
 /// Bumped whenever the output for the same input changes (invalidates the cache).
-pub const VERSION: u32 = 41;
+pub const VERSION: u32 = 42;
 
 #[cfg(test)]
 mod tests;
