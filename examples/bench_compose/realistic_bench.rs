@@ -296,6 +296,15 @@ pub fn run(args: &[String]) {
                         });
                         placed.push(inp.visual.geometry().transformed(&est.matrix()));
                         truth_placed.push(inp.visual.geometry().transformed(&s.truth[n].matrix()));
+                        if verbose && n > 0 {
+                            miss_probe::contact(
+                                id,
+                                inp,
+                                (&placed[0], &est),
+                                (&truth_placed[0], &s.truth[n]),
+                                r.contact.as_ref(),
+                            );
+                        }
                     }
                     let mopts = MetricsOptions {
                         points: 100_000,

@@ -22,6 +22,7 @@ pub mod agent;
 pub mod bleed;
 pub mod cloud;
 pub mod colour;
+pub mod contact_scale;
 pub mod features;
 pub mod folder;
 pub mod global;
@@ -161,6 +162,9 @@ pub struct ObjectResult {
     pub colour_used: bool,
     #[serde(skip_serializing_if = "Option::is_none")]
     pub refinement: Option<RefineReport>,
+    /// The contact-scale stage on an item placed after the anchor ([`contact_scale`]).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub contact: Option<contact_scale::ContactReport>,
 }
 
 #[derive(Clone, Copy, Debug, Serialize)]
@@ -580,6 +584,29 @@ pub fn compose(inputs: &[ObjectInput], o: &ComposeOptions) -> Result<Composition
         let mut pose_stage = reg.pose_stage.clone();
         let mut stages = reg.stages.clone();
         let mut refinement = None;
+        let mut contact = None;
+        // An item's size from its resting contact with the placed objects, where the guidance
+        // does not show it ([`contact_scale`]); the guard decides, within the guidance's noise.
+        if let (Some(f), true) = (&field, rank > 0 && o.method.refines()) {
+            let offsets = (plane_icp::scale_offset_correlation(&object) < OFFSET_CORRELATION_MAX)
+                .then_some(OFFSET_MAX);
+            let (g, report) = contact_scale::run(
+                &object,
+                &object_tree,
+                spacing,
+                guidance,
+                guidance.subsample(1000).points,
+                t,
+                &pose_stage,
+                f,
+                offsets,
+                &Default::default(),
+            );
+            t = g.pose();
+            pose_stage = g.stage().to_string();
+            stages.extend(g.log().iter().skip(1).cloned());
+            contact = Some(report);
+        }
         // The object's welded mesh, built once for the dense check and the anchor field.
         let geometry = std::cell::OnceCell::new();
         let geometry = || geometry.get_or_init(|| inp.visual.geometry());
@@ -691,6 +718,7 @@ pub fn compose(inputs: &[ObjectInput], o: &ComposeOptions) -> Result<Composition
             hypotheses: reg.hypotheses,
             colour_used,
             refinement,
+            contact,
         });
     }
     Ok(Composition {
