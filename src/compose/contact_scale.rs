@@ -33,9 +33,9 @@
 //! the guidance's own noise ([`ContactCandidate::noise`], the robust σ of the point-to-plane
 //! residuals at the current pose): the contact may cost the guidance fit no more than that.
 //!
-//! Entry points: [`run`] (the stage as the pipeline calls it: candidate, guard, [`ContactReport`]),
-//! [`ContactOptions`], [`gap`], [`contact_scale`] (a [`ContactCandidate`] or the reason it was
-//! not made, [`Skip`]).
+//! Entry points: [`run`] (the stage: candidate, guard, [`ContactReport`]; [`apply`] is how the
+//! pipeline calls it), [`ContactOptions`], [`gap`], [`contact_scale`] (a [`ContactCandidate`] or
+//! the reason it was not made, [`Skip`]).
 
 use super::cloud::Cloud;
 use super::guard::Guard;
@@ -351,6 +351,33 @@ pub fn run<'a>(
         },
     };
     (guard, report)
+}
+
+/// The stage as the pipeline calls it on an item placed after the anchor: [`run`] from the
+/// registration's pose `t` and stage, with the normal offsets measured where the shape allows
+/// them, and the guard's pose, stage and log folded back into `t`, `pose_stage` and `stages`.
+#[allow(clippy::too_many_arguments)]
+pub(super) fn apply(
+    object: &Cloud,
+    tree: &KdTree,
+    spacing: f64,
+    guidance: &Cloud,
+    field: &AnchorField,
+    o: &ContactOptions,
+    t: &mut Similarity,
+    pose_stage: &mut String,
+    stages: &mut Vec<super::guard::StageFit>,
+) -> ContactReport {
+    let offsets = (scale_offset_correlation(object) < super::OFFSET_CORRELATION_MAX)
+        .then_some(super::OFFSET_MAX);
+    let probe = guidance.subsample(1000).points;
+    let (g, report) = run(
+        object, tree, spacing, guidance, probe, *t, pose_stage, field, offsets, o,
+    );
+    *t = g.pose();
+    *pose_stage = g.stage().to_string();
+    stages.extend(g.log().iter().skip(1).cloned());
+    report
 }
 
 #[cfg(test)]
