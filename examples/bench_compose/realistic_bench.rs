@@ -166,8 +166,8 @@ pub fn run(args: &[String]) {
         .map(|s| s.split(',').map(str::to_string).collect())
         .unwrap_or_default();
     let verbose = args.iter().any(|a| a == "-v");
-    // The contact-scale stage: `on` (default), `off`, or `ungated` (no coverage gate: the gap,
-    // the lever and the guard decide).
+    // The contact-scale stage: `on` (default), `off`, `ungated` (no coverage gate: the gap,
+    // the lever and the guard decide) or `grow` (ungated, floating items only).
     let contact = match value("--contact").map(String::as_str) {
         None | Some("on") => Some(ContactOptions::default()),
         Some("off") => None,
@@ -175,8 +175,13 @@ pub fn run(args: &[String]) {
             coverage_max: f64::INFINITY,
             ..Default::default()
         }),
+        Some("grow") => Some(ContactOptions {
+            coverage_max: f64::INFINITY,
+            grow_only: true,
+            ..Default::default()
+        }),
         Some(other) => {
-            eprintln!("--contact {other}: expected on, off or ungated");
+            eprintln!("--contact {other}: expected on, off, ungated or grow");
             std::process::exit(2);
         }
     };
