@@ -4,7 +4,7 @@
 //! one that is still coming to rest when the settle test's cap ends (a decaying speed).
 //!
 //! Run: `cargo run --release --example agreement_trace -- SEED [SECONDS] [WINDOW_S]
-//!       [--set solver_iterations=N|pgs_iterations=N|coulomb_friction=0/1|contact_clustering=0/1|
+//!       [--set solver_iterations=N|pgs_iterations=N|load_ratio=K|coulomb_friction=0/1|contact_clustering=0/1|
 //!        friction_in_bias_pass=0/1|sleep=0/1]` (defaults 20 s, 1 s windows, the library's
 //! settle options; `sleep=0` keeps every body awake as the rest check does).
 
@@ -28,6 +28,9 @@ fn main() {
             match k {
                 "solver_iterations" => opts.solver_iterations = x as usize,
                 "pgs_iterations" => opts.pgs_iterations = x as usize,
+                "load_ratio" => opts.load_ratio = x,
+                "loaded_solver_iterations" => opts.loaded_solver_iterations = x as usize,
+                "loaded_pgs_iterations" => opts.loaded_pgs_iterations = x as usize,
                 "coulomb_friction" => opts.coulomb_friction = x != 0.0,
                 "contact_clustering" => opts.contact_clustering = x != 0.0,
                 "friction_in_bias_pass" => opts.friction_in_bias_pass = x != 0.0,

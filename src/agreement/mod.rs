@@ -270,6 +270,9 @@ pub struct Ours {
     pub seconds: f64,
     /// Bodies: name, bounding-box diagonal (m), marginal by our probe.
     pub bodies: Vec<OurBody>,
+    /// Bodies whose contact islands ran the loaded solver iterations
+    /// ([`crate::physics::SettleOptions::load_ratio`]); empty: the scene ran the plain solver.
+    pub heavily_loaded: Vec<String>,
 }
 
 #[derive(Clone, Debug, Serialize)]
@@ -348,5 +351,6 @@ pub fn run_scene_with(
         reasons,
         seconds,
         bodies,
+        heavily_loaded: v.settle.heavily_loaded.clone(),
     })
 }

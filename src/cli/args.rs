@@ -273,6 +273,10 @@ pub struct BuildArgs {
     /// Cache decompositions here (keyed by a hash of the meshes and options).
     #[arg(long, value_name = "DIR")]
     pub decompose_cache: Option<PathBuf>,
+    /// Run each object's decomposition strategies to the end instead of dropping one far
+    /// behind at a checkpoint (slower; checks the race's margins, docs/speed.md).
+    #[arg(long)]
+    pub no_race: bool,
 }
 
 #[derive(Args)]
@@ -448,6 +452,7 @@ impl BuildArgs {
         };
         o.decompose.resolution = self.vhacd_resolution;
         o.decompose.cache_dir = self.decompose_cache.clone();
+        o.decompose.race = !self.no_race;
         o
     }
 }

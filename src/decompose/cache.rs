@@ -87,6 +87,11 @@ pub fn key(engine: &str, version: u32, opts: &DecomposeOptions, objects: &[&Mesh
         h.update(b"max_polygons");
         h.update((opts.max_polygons as u64).to_le_bytes());
     }
+    // Only without the race (it may then keep another strategy), so keys with it are what
+    // they were.
+    if !opts.race {
+        h.update(b"no_race");
+    }
     h.update((objects.len() as u64).to_le_bytes());
     for m in objects {
         h.update((m.vertices.len() as u64).to_le_bytes());

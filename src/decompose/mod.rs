@@ -56,6 +56,10 @@ pub struct DecomposeOptions {
     pub clearance: f64,
     /// Folder of the decomposition cache (content-addressed); `None`: no cache.
     pub cache_dir: Option<std::path::PathBuf>,
+    /// Scene-aware engine: race an object's strategies and drop one far behind at a
+    /// checkpoint (`scene_aware/race.rs`); `false` runs every strategy to the end (slower; the
+    /// check that the race's margins keep the winner).
+    pub race: bool,
 }
 
 impl Default for DecomposeOptions {
@@ -70,6 +74,7 @@ impl Default for DecomposeOptions {
             tolerance: 0.01,
             clearance: 1e-4,
             cache_dir: None,
+            race: true,
         }
     }
 }

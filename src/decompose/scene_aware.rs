@@ -102,6 +102,7 @@ mod contacts;
 mod cover;
 mod engine;
 mod fit;
+mod fps;
 pub mod geom;
 mod memo;
 pub mod metrics;
@@ -110,6 +111,7 @@ mod parts;
 pub mod patches;
 mod polish;
 mod project;
+mod race;
 mod rebalance;
 mod refit;
 mod report;
@@ -142,7 +144,7 @@ use std::sync::Mutex;
 /// Engine name, recorded in reports and in the cache key.
 pub const NAME: &str = "scene_aware";
 /// Bumped whenever the output for the same input changes (invalidates the cache).
-pub const VERSION: u32 = 40;
+pub const VERSION: u32 = 41;
 
 #[cfg(test)]
 mod tests;

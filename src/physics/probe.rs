@@ -17,10 +17,12 @@ use super::world::Sim;
 use super::*;
 
 /// Worst (displacement m, rotation degrees) of each body from `rest` at the end of a probe
-/// (zeros for fixed bodies, and for every body when the probe is off).
+/// (zeros for fixed bodies, and for every body when the probe is off). `loaded`: the settle
+/// test's heavily loaded bodies, which keep their extra iterations in the probes.
 pub(super) fn probe(
     bodies: &[SimBody],
     rest: &[Isometry3<f64>],
+    loaded: &[bool],
     opts: &SettleOptions,
 ) -> Result<Vec<(f64, f64)>, PhysicsError> {
     let n = bodies.len();
@@ -62,6 +64,7 @@ pub(super) fn probe(
             })
             .collect();
         let mut sim = Sim::new(&nudged, opts)?;
+        sim.load_extra_iterations(loaded);
         for i in (0..n).filter(|&i| !bodies[i].fixed) {
             let act = sim.world.bodies[sim.handles[i]].activation_mut();
             act.normalized_linear_threshold = -1.0;

@@ -1,6 +1,7 @@
 //! The settle test itself: [`settle`] (settle phase, rest phase, verdicts) and [`simulate`]
 //! (a plain run that records poses).
 
+use super::load_ratio::heavily_loaded;
 use super::world::Sim;
 use super::*;
 
@@ -12,6 +13,8 @@ pub fn settle(bodies: &[SimBody], opts: &SettleOptions) -> Result<SettleReport, 
 
     // Composed pose: supports and initial penetration.
     let start = sim.contact_graph(opts.support_distance);
+    let loaded = heavily_loaded(bodies, &start.supports, opts.load_ratio);
+    sim.load_extra_iterations(&loaded);
     let composed: Vec<Isometry3<f64>> = (0..n).map(|i| sim.pose(i)).collect();
     sim.kick();
 
@@ -72,7 +75,7 @@ pub fn settle(bodies: &[SimBody], opts: &SettleOptions) -> Result<SettleReport, 
         }
     }
     let finals: Vec<Isometry3<f64>> = (0..n).map(|i| sim.pose(i)).collect();
-    let probed = super::probe::probe(bodies, &finals, opts)?;
+    let probed = super::probe::probe(bodies, &finals, &loaded, opts)?;
 
     // Verdicts.
     let name_of = |k: Option<usize>| k.map(|k| sim.name(k).to_string());
@@ -237,6 +240,10 @@ pub fn settle(bodies: &[SimBody], opts: &SettleOptions) -> Result<SettleReport, 
     Ok(SettleReport {
         passed: reports.iter().all(|r| r.passed),
         marginal,
+        heavily_loaded: (0..n)
+            .filter(|&i| loaded[i])
+            .map(|i| bodies[i].name.clone())
+            .collect(),
         bodies: reports,
         time_to_sleep,
         settle_steps,
@@ -256,6 +263,8 @@ pub fn simulate(
     record_every: usize,
 ) -> Result<Trajectory, PhysicsError> {
     let mut sim = Sim::new(bodies, opts)?;
+    let start = sim.contact_graph(opts.support_distance);
+    sim.load_extra_iterations(&heavily_loaded(bodies, &start.supports, opts.load_ratio));
     sim.kick();
     let steps = steps_for(duration, opts.dt);
     let frame = |sim: &Sim| -> Vec<PoseRecord> {

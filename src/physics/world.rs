@@ -434,6 +434,9 @@ pub(super) fn validate_options(o: &SettleOptions) -> Result<(), PhysicsError> {
     if o.pgs_iterations == 0 {
         return bad("pgs_iterations must be at least 1");
     }
+    if o.load_ratio.is_nan() || o.load_ratio < 0.0 {
+        return bad("load_ratio must be >= 0 (0: off)");
+    }
     let nonneg = [
         ("gravity", o.gravity),
         ("settle_max_time", o.settle_max_time),

@@ -468,8 +468,8 @@ pub fn farthest_points(pts: &[P3], k: usize) -> Vec<usize> {
     // Coordinates apart, padded to whole lanes of `LANES` points, each lane keeping its own
     // farthest: the update and the maximum then run several points at a time in one pass
     // (2× quicker than one pass for each on 500 points, 3× on 10,000). The farthest is then
-    // found by value, the first of equals.
-    const LANES: usize = 8;
+    // found by value, the first of equals (`fps::picks`, AVX2 where the processor has it).
+    const LANES: usize = super::fps::LANES;
     let n = pts.len();
     let padded = n.div_ceil(LANES) * LANES;
     let (mut xs, mut ys, mut zs) = (vec![0.0; padded], vec![0.0; padded], vec![0.0; padded]);
@@ -479,46 +479,7 @@ pub fn farthest_points(pts: &[P3], k: usize) -> Vec<usize> {
     // The padding is at distance 0: never the farthest.
     let mut dist = vec![f64::INFINITY; padded];
     dist[n..].fill(0.0);
-    let mut kept = vec![first];
-    let mut last = first;
-    while kept.len() < k {
-        let (lx, ly, lz) = (xs[last], ys[last], zs[last]);
-        // Each lane's largest and the chunk of its first occurrence: the first of equals
-        // overall is then the lowest index among the lanes holding the largest, with no
-        // second pass over the distances to find it.
-        let mut lanes = [0.0f64; LANES];
-        let mut at = [0usize; LANES];
-        for (c, (((d, x), y), z)) in dist
-            .chunks_exact_mut(LANES)
-            .zip(xs.chunks_exact(LANES))
-            .zip(ys.chunks_exact(LANES))
-            .zip(zs.chunks_exact(LANES))
-            .enumerate()
-        {
-            for l in 0..LANES {
-                let (dx, dy, dz) = (x[l] - lx, y[l] - ly, z[l] - lz);
-                let e = dx * dx + dy * dy + dz * dz;
-                let v = if e < d[l] { e } else { d[l] };
-                d[l] = v;
-                let up = v > lanes[l];
-                lanes[l] = if up { v } else { lanes[l] };
-                at[l] = if up { c } else { at[l] };
-            }
-        }
-        let far = lanes
-            .iter()
-            .fold(0.0, |m: f64, &d| if d > m { d } else { m });
-        if far <= 0.0 {
-            break;
-        }
-        last = (0..LANES)
-            .filter(|&l| lanes[l] == far)
-            .map(|l| at[l] * LANES + l)
-            .min()
-            .expect("far is a lane's largest");
-        kept.push(last);
-    }
-    kept
+    super::fps::picks(&xs, &ys, &zs, &mut dist, first, k)
 }
 
 /// At most `k` vertices of a convex hull chosen greedily to lose the least: seeded by

@@ -144,6 +144,16 @@ pub(super) fn decompose_object(
         let (parts, report) = grow_parts(s, &feat, &p, opts, &fixed, &rest, budget, effort, near);
         (parts, report, p)
     };
+    let ctx = race::Ctx {
+        s,
+        feat: &feat,
+        opts,
+        fixed: &fixed,
+        rest: &rest,
+        budget,
+        effort,
+        near,
+    };
     // One strategy for a set of closed convex pieces, and under a neighbour leaning on its side
     // (see `Strategy`).
     let strategies = if rest.is_empty() || (!carried.is_empty() && leaned_on(s, near, opts)) {
@@ -157,10 +167,7 @@ pub(super) fn decompose_object(
         (distance_stats(s, &hulls_of(&r.0)), r)
     };
     let p95 = |d: &Option<(f64, f64)>| d.map_or(f64::INFINITY, |x| x.0);
-    let (mut dist, (mut parts, mut report, p)) = strategies
-        .par_iter()
-        .map(|&st| measured(st))
-        .collect::<Vec<_>>()
+    let (mut dist, (mut parts, mut report, p)) = race::race(&ctx, strategies)
         .into_iter()
         .reduce(|a, b| if p95(&b.0) < p95(&a.0) { b } else { a })
         .unwrap_or_else(|| measured(Strategy::Patches));
@@ -229,13 +236,32 @@ pub(super) fn grow_parts(
     effort: Effort,
     near: &[f64],
 ) -> (Vec<Part>, ObjectReport) {
+    let c = race::Ctx {
+        s,
+        feat,
+        opts,
+        fixed,
+        rest,
+        budget,
+        effort,
+        near,
+    };
+    let at = grow_to_quality(&c, p);
+    let at = grow_rebalanced(&c, p, at);
+    grow_from_checkpoint(&c, p, at)
+}
+
+/// [`grow_parts`] up to the strategy race's first checkpoint (see `race.rs`): the k-means
+/// patches and the quality loop.
+pub(super) fn grow_to_quality(c: &race::Ctx, p: &Params) -> (Vec<Part>, ObjectReport) {
+    let (s, feat, opts, budget) = (c.s, c.feat, c.opts, c.budget);
     let mut report = ObjectReport::default();
-    let mut parts = fixed.to_vec();
-    if !rest.is_empty() {
+    let mut parts = c.fixed.to_vec();
+    if !c.rest.is_empty() {
         let k0 = p
             .strategy
             .initial_patches(budget.saturating_sub(parts.len()));
-        let groups = patches::kmeans(s, feat, rest, k0, p.lambda, 16);
+        let groups = patches::kmeans(s, feat, c.rest, k0, p.lambda, 16);
         parts.extend(
             groups
                 .into_par_iter()
@@ -244,15 +270,42 @@ pub(super) fn grow_parts(
         );
     }
     report.quality_splits = quality_loop(s, feat, p, opts, &mut parts, budget, &|_| true);
-    if parts.len() >= budget {
-        report.rebalance_rounds =
-            rebalance::rebalance(s, feat, p, opts, &mut parts, effort.rebalance, near);
-        if effort.polish > 0 {
-            (report.trimmed_patches, report.polish_rounds) =
-                polish::polish(s, feat, p, opts, &mut parts, effort.polish, near);
-        }
+    (parts, report)
+}
+
+/// [`grow_parts`] from [`grow_to_quality`] to the race's second checkpoint: the rebalancing,
+/// when the budget is spent.
+pub(super) fn grow_rebalanced(
+    c: &race::Ctx,
+    p: &Params,
+    (mut parts, mut report): (Vec<Part>, ObjectReport),
+) -> (Vec<Part>, ObjectReport) {
+    if parts.len() >= c.budget {
+        report.rebalance_rounds = rebalance::rebalance(
+            c.s,
+            c.feat,
+            p,
+            c.opts,
+            &mut parts,
+            c.effort.rebalance,
+            c.near,
+        );
     }
-    report.refitted = refit::refit(s, p, opts, &mut parts, near);
+    (parts, report)
+}
+
+/// The rest of [`grow_parts`] after [`grow_rebalanced`]: the polishing (budget spent) and
+/// the refit; the parts' memo is emptied.
+pub(super) fn grow_from_checkpoint(
+    c: &race::Ctx,
+    p: &Params,
+    (mut parts, mut report): (Vec<Part>, ObjectReport),
+) -> (Vec<Part>, ObjectReport) {
+    if parts.len() >= c.budget && c.effort.polish > 0 {
+        (report.trimmed_patches, report.polish_rounds) =
+            polish::polish(c.s, c.feat, p, c.opts, &mut parts, c.effort.polish, c.near);
+    }
+    report.refitted = refit::refit(c.s, p, c.opts, &mut parts, c.near);
     p.memo.clear();
     (parts, report)
 }

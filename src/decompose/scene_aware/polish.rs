@@ -239,6 +239,11 @@ pub(super) fn polish(
     let mut lift_of: BTreeMap<u64, f64> = BTreeMap::new();
     let mut stuck: Vec<u64> = Vec::new();
     let (mut kept, mut failed) = (0, 0);
+    // What a round measures on the parts as they are, kept while no move is: the same hulls,
+    // samples and threshold give the same excesses (each hull's, and each merge's by the
+    // pair of part ids).
+    let mut ex_of: Option<Vec<f64>> = None;
+    let mut merge_ex: BTreeMap<(u64, u64), f64> = BTreeMap::new();
     for _ in 0..2 * rounds {
         if kept >= rounds || failed >= MAX_FAILS || parts.len() < 3 || cur.0 <= p.tol {
             break;
@@ -246,10 +251,14 @@ pub(super) fn polish(
         let thr = cur.0;
         let owned: Vec<Hull> = hulls_of(parts);
         let hulls: Vec<&Hull> = owned.iter().collect();
-        let ex: Vec<f64> = (0..parts.len())
-            .into_par_iter()
-            .map(|i| smp[i].excess(s, &hulls, &[i], eps, thr))
-            .collect();
+        let ex: Vec<f64> = ex_of
+            .get_or_insert_with(|| {
+                (0..parts.len())
+                    .into_par_iter()
+                    .map(|i| smp[i].excess(s, &hulls, &[i], eps, thr))
+                    .collect()
+            })
+            .clone();
         let Some(w) = (0..parts.len())
             .filter(|&i| {
                 parts[i].tris.len() >= 2
@@ -315,21 +324,40 @@ pub(super) fn polish(
                 if is_pinned(&parts[i]) || is_pinned(&parts[j]) {
                     return None;
                 }
-                let m = build_merge(s, p, opts, &parts[i], &parts[j])?;
+                let m = build_merge(s, p, opts, &parts[i], &parts[j], f64::INFINITY)?;
                 (lift(s, &m.hull, &m.tris) <= top(i, j) && !is_pinned(&m)).then(|| sampled(m))
             })
             .collect();
         for (&(i, j), b) in missing.iter().zip(built) {
             merged.insert((ids[i], ids[j]), b);
         }
-        let merge = pairs
-            .iter()
-            .filter_map(|&(i, j)| {
-                let (_, ms) = merged.get(&(ids[i], ids[j]))?.as_ref()?;
-                let added = ms.excess(s, &hulls, &[i, j], eps, thr) - ex[i] - ex[j];
-                Some((added, i, j))
-            })
-            .min_by(|a, b| a.0.total_cmp(&b.0).then((a.1, a.2).cmp(&(b.1, b.2))));
+        // The merge adding least excess (ties: the first pair). A merge's excess is counted
+        // only while what it adds is not above the least so far (the count only grows, and
+        // `e - ex[i] - ex[j]` grows with it); one left out so would not be chosen.
+        let mut merge: Option<(f64, usize, usize)> = None;
+        for &(i, j) in &pairs {
+            let Some(Some((_, ms))) = merged.get(&(ids[i], ids[j])) else {
+                continue;
+            };
+            let added = |e: f64| e - ex[i] - ex[j];
+            let e = match merge_ex.get(&(ids[i], ids[j])) {
+                Some(&e) => Some(e),
+                None => {
+                    let least = merge.map_or(f64::INFINITY, |m| m.0);
+                    let ok = |e: f64| added(e).total_cmp(&least).is_le();
+                    let e = ms.excess_while(s, &hulls, &[i, j], eps, thr, 0.0, &ok);
+                    if let Some(e) = e {
+                        merge_ex.insert((ids[i], ids[j]), e);
+                    }
+                    e
+                }
+            };
+            if let Some(e) = e {
+                if merge.is_none_or(|m| added(e).total_cmp(&m.0).is_lt()) {
+                    merge = Some((added(e), i, j));
+                }
+            }
+        }
         let mut trial: Vec<(usize, Sampled)> = Vec::new();
         if let Some((added, i, j)) = merge {
             let limit = lifts[w].max(CONTACT_DEV * p.tol);
@@ -390,6 +418,8 @@ pub(super) fn polish(
             }
         }
         if done {
+            ex_of = None;
+            merge_ex.clear();
             kept += 1;
             failed = 0;
         } else {

@@ -33,7 +33,7 @@
 
 use super::geom::Surface;
 use super::patches::Features;
-use super::{build_part, split, Params, Part, CONTACT_DEV, SUPPORT_NZ};
+use super::{build_part_below, split, Params, Part, CONTACT_DEV, SUPPORT_NZ};
 use crate::decompose::DecomposeOptions;
 use rayon::prelude::*;
 use std::collections::BTreeMap;
@@ -89,10 +89,14 @@ pub(super) fn rebalance(
             .copied()
             .filter(|&(i, j)| !merged.contains_key(&(ids[i], ids[j])))
             .collect();
+        // Built below `worst`: a merge deviating more is never kept (move 1 needs `m.dev <
+        // worst`), neither now nor later, since `worst` never grows from round to round (the
+        // parts a kept move makes deviate less, the others keep their deviation and the set
+        // aside stay aside). The least merge below it is the least of all when one is below.
         let built: Vec<Option<(Part, f64)>> = missing
             .par_iter()
             .map(|&(i, j)| {
-                let m = build_merge(s, p, opts, &parts[i], &parts[j])?;
+                let m = build_merge(s, p, opts, &parts[i], &parts[j], worst)?;
                 let l = lift(s, &m.hull, &m.tris);
                 Some((m, l))
             })
@@ -120,6 +124,11 @@ pub(super) fn rebalance(
         let Some((a, b)) = halves else {
             // Move 2: move w's border with one of its neighbours (merge the two, split again)
             // when that brings both below w's deviation.
+            // The least worse half of a neighbour's move kept so far: another neighbour's split
+            // is built below it (ties admitted, then broken by the neighbour's index), since
+            // only the least is kept. A neighbour whose closest split is not below it would
+            // lose; one whose closest split is below it gets the same split as below `worst`.
+            let least = std::sync::Mutex::new(worst);
             let relaxed = adj[w]
                 .par_iter()
                 .filter_map(|&j| {
@@ -128,12 +137,18 @@ pub(super) fn rebalance(
                         tris: union(&parts[w], &parts[j]),
                         ..parts[w].clone()
                     };
-                    let (a, b) = split(s, f, p, opts, &both, worst)?;
+                    let l = *least.lock().expect("no panic holding it");
+                    let bound = if l < worst { l.next_up() } else { worst };
+                    let (a, b) = split(s, f, p, opts, &both, bound)?;
                     let ok = !is_pinned(&parts[j].tris, parts[j].dev)
                         && !is_pinned(&a.tris, a.dev)
                         && !is_pinned(&b.tris, b.dev)
                         && lift(s, &a.hull, &a.tris) <= top(w, j)
                         && lift(s, &b.hull, &b.tris) <= top(w, j);
+                    if ok {
+                        let mut l = least.lock().expect("no panic holding it");
+                        *l = l.min(a.dev.max(b.dev));
+                    }
                     ok.then_some((a.dev.max(b.dev), j, a, b))
                 })
                 .min_by(|x, y| x.0.total_cmp(&y.0).then(x.1.cmp(&y.1)));
@@ -249,15 +264,17 @@ pub(super) fn adjacent_pairs(adj: &[Vec<usize>], w: usize) -> Vec<(usize, usize)
 }
 
 /// The part two patches make together, with the first one's cuts (every merge keeps them), or
-/// `None` when their triangles make no part.
+/// `None` when their triangles make no part or it deviates `bound` or more (see
+/// [`build_part_below`]; `f64::INFINITY`: any deviation).
 pub(super) fn build_merge(
     s: &Surface,
     p: &Params,
     opts: &DecomposeOptions,
     a: &Part,
     b: &Part,
+    bound: f64,
 ) -> Option<Part> {
-    build_part(s, p, opts, union(a, b), a.cuts.clone())
+    build_part_below(s, p, opts, union(a, b), a.cuts.clone(), bound)
 }
 
 /// The triangles of two patches, ascending.

@@ -163,7 +163,7 @@ pub(super) fn unfill(
                 if is_pinned(&parts[i]) || is_pinned(&parts[j]) {
                     return None;
                 }
-                let m = build_merge(s, p, opts, &parts[i], &parts[j])?;
+                let m = build_merge(s, p, opts, &parts[i], &parts[j], f64::INFINITY)?;
                 let top = lift(s, &parts[i].hull, &parts[i].tris)
                     .max(lift(s, &parts[j].hull, &parts[j].tris))
                     .max(CONTACT_DEV * p.tol);
