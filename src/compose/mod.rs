@@ -566,6 +566,7 @@ pub fn compose(inputs: &[ObjectInput], o: &ComposeOptions) -> Result<Composition
         if let (Some(f), Some(c), true) = (&field, &o.contact, rank > 0 && o.method.refines()) {
             let (st, all) = (&mut pose_stage, &mut stages);
             let r = contact_scale::apply(
+                &inp.visual,
                 &object,
                 &object_tree,
                 spacing,
