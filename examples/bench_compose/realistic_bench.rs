@@ -1,8 +1,10 @@
 //! The realistic benchmark (issue #34): pairs of shared objects, guidance from
 //! `compose::realistic`, ADD-S and scale per object, success per seed, time per pair.
 
+use interact3d::compose::contact_scale::ContactOptions;
 use interact3d::compose::realistic::{self, AddS, SourceObject};
 use interact3d::compose::reconstruction::{self, ReconOptions};
+use interact3d::compose::rest;
 use interact3d::compose::{compose, ComposeOptions};
 use interact3d::metrics::{pair_metrics, MetricsOptions, Prepared, Solid};
 use interact3d::rng::Rng;
@@ -122,6 +124,8 @@ struct SceneRecord {
     seed: u64,
     r_volume: f64,
     truth_r_volume: f64,
+    /// The true item's exact gap to the true support, as a fraction of its diagonal.
+    truth_gap: f64,
     secs: f64,
 }
 
@@ -162,6 +166,25 @@ pub fn run(args: &[String]) {
         .map(|s| s.split(',').map(str::to_string).collect())
         .unwrap_or_default();
     let verbose = args.iter().any(|a| a == "-v");
+    // The contact-scale stage: `on` (default), `off`, `ungated` (no coverage gate: the gap,
+    // the lever and the guard decide) or `grow` (ungated, floating items only).
+    let contact = match value("--contact").map(String::as_str) {
+        None | Some("on") => Some(ContactOptions::default()),
+        Some("off") => None,
+        Some("ungated") => Some(ContactOptions {
+            coverage_max: f64::INFINITY,
+            ..Default::default()
+        }),
+        Some("grow") => Some(ContactOptions {
+            coverage_max: f64::INFINITY,
+            grow_only: true,
+            ..Default::default()
+        }),
+        Some(other) => {
+            eprintln!("--contact {other}: expected on, off, ungated or grow");
+            std::process::exit(2);
+        }
+    };
     // The earlier realistic guidance: the objects' own surfaces, subdivided, with holes.
     let subdivided = args.iter().any(|a| a == "--subdivided");
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
@@ -234,6 +257,7 @@ pub fn run(args: &[String]) {
                         .collect();
                     let o = ComposeOptions {
                         seed,
+                        contact,
                         ..Default::default()
                     };
                     let t0 = Instant::now();
@@ -296,6 +320,15 @@ pub fn run(args: &[String]) {
                         });
                         placed.push(inp.visual.geometry().transformed(&est.matrix()));
                         truth_placed.push(inp.visual.geometry().transformed(&s.truth[n].matrix()));
+                        if verbose && n > 0 {
+                            miss_probe::contact(
+                                id,
+                                inp,
+                                (&placed[0], &est),
+                                (&truth_placed[0], &s.truth[n]),
+                                r.contact.as_ref(),
+                            );
+                        }
                     }
                     let mopts = MetricsOptions {
                         points: 100_000,
@@ -306,17 +339,21 @@ pub fn run(args: &[String]) {
                         let b = Prepared::new(Solid::Mesh(&m[1]));
                         pair_metrics(&a, &b, &mopts).r_volume
                     };
+                    let diagonal = interact3d::mesh::Aabb::of_points(&truth_placed[1].vertices)
+                        .map_or(0.0, |b| b.extents().norm());
                     let scene_rec = SceneRecord {
                         seed,
                         r_volume: rv(&placed),
                         truth_r_volume: rv(&truth_placed),
+                        truth_gap: rest::mesh_gap(&truth_placed[0], &truth_placed[1]) / diagonal,
                         secs,
                     };
                     if verbose {
                         eprintln!(
-                            "pair {k:2} seed {seed}: {sid} + {iid}: {secs:.2} s ({wall:.2} s wall), R_volume {:.1e} (truth {:.1e}), done at {:.0} s",
+                            "pair {k:2} seed {seed}: {sid} + {iid}: {secs:.2} s ({wall:.2} s wall), R_volume {:.1e} (truth {:.1e}, true gap {:.3} % of the item's diagonal), done at {:.0} s",
                             scene_rec.r_volume,
                             scene_rec.truth_r_volume,
+                            100.0 * scene_rec.truth_gap,
                             t_all.elapsed().as_secs_f64()
                         );
                     }
@@ -366,6 +403,30 @@ pub fn run(args: &[String]) {
         "\nground-truth scenes: max R_volume {:.1e} (the truth's own contact, for reference)",
         scenes.iter().map(|s| s.truth_r_volume).fold(0.0, f64::max)
     );
+    // The truth rests: R_volume 0 and every item's exact gap in [0, 2 × the clearance].
+    let bad_truth = scenes
+        .iter()
+        .filter(|s| {
+            s.truth_r_volume > 0.0
+                || !(0.0..=2.0 * realistic::REST_CLEARANCE).contains(&s.truth_gap)
+        })
+        .count();
+    for &sd in &seed_list {
+        let g = scenes
+            .iter()
+            .filter(|s| s.seed == sd)
+            .map(|s| s.truth_gap)
+            .fold(0.0, f64::max);
+        println!(
+            "seed {sd}: max true gap {:.3} % of the item's diagonal",
+            100.0 * g
+        );
+    }
+    println!(
+        "truth check (R_volume 0, gap within [0, {:.1} %]): {bad_truth} of {} scenes fail",
+        200.0 * realistic::REST_CLEARANCE,
+        scenes.len()
+    );
 
     println!("\n#### Per object (over seeds): ADD-S and scale error in % of the object's diagonal / size\n");
     println!("| pair | object | ≤ 2 % | ≤ 5 % | mean ADD-S | worst ADD-S | mean scale err | worst scale err | mean signed scale err | guidance outliers | object uncovered | guidance offset | guidance extent ratio | winning stages |");
@@ -412,4 +473,7 @@ pub fn run(args: &[String]) {
         jobs,
         t_all.elapsed().as_secs_f64()
     );
+    if bad_truth > 0 {
+        std::process::exit(1);
+    }
 }

@@ -22,6 +22,7 @@ pub mod agent;
 pub mod bleed;
 pub mod cloud;
 pub mod colour;
+pub mod contact_scale;
 pub mod features;
 pub mod folder;
 pub mod global;
@@ -34,6 +35,7 @@ pub mod plane_icp;
 pub mod realistic;
 pub mod reconstruction;
 pub mod refine;
+pub mod rest;
 pub mod scale;
 pub mod sdf;
 pub mod synth;
@@ -114,6 +116,8 @@ pub struct ComposeOptions {
     pub object_samples: usize,
     pub guidance_samples: usize,
     pub refine: RefineOptions,
+    /// The contact-scale stage's settings; `None` switches the stage off.
+    pub contact: Option<contact_scale::ContactOptions>,
 }
 
 impl Default for ComposeOptions {
@@ -125,6 +129,7 @@ impl Default for ComposeOptions {
             object_samples: 5000,
             guidance_samples: 2500,
             refine: RefineOptions::default(),
+            contact: Some(Default::default()),
         }
     }
 }
@@ -161,6 +166,9 @@ pub struct ObjectResult {
     pub colour_used: bool,
     #[serde(skip_serializing_if = "Option::is_none")]
     pub refinement: Option<RefineReport>,
+    /// The contact-scale stage on an item placed after the anchor ([`contact_scale`]).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub contact: Option<contact_scale::ContactReport>,
 }
 
 #[derive(Clone, Copy, Debug, Serialize)]
@@ -413,7 +421,7 @@ fn register(
         // erodes the guidance by a roughly constant depth, which a similarity alone reads as
         // scale. Judged by the guard with each pose's own offset taken out.
         if plane_icp::scale_offset_correlation(object) < OFFSET_CORRELATION_MAX {
-            offset_stage(object, &matcher, &g_icp, &pl, &icp, &mut guard, &mut rms);
+            plane_icp::offset_stage(object, &matcher, &g_icp, &pl, &icp, &mut guard, &mut rms);
         }
     }
     let t = guard.pose();
@@ -436,34 +444,6 @@ fn register(
         colour_used: use_colour,
         pose_stage: guard.stage().to_string(),
         stages: guard.log().to_vec(),
-    }
-}
-
-/// The point-to-plane fit with a normal offset beside the scale (see [`OFFSET_MAX`]): a
-/// reconstruction's blur fattens or erodes the guidance by a roughly constant depth, which a
-/// similarity alone reads as scale. From then on the guard judges every pose with its own
-/// offset taken out.
-fn offset_stage(
-    object: &Cloud,
-    matcher: &icp::Matcher,
-    g_icp: &Cloud,
-    pl: &plane_icp::PlaneIcpOptions,
-    icp: &IcpOptions,
-    guard: &mut guard::Guard,
-    rms: &mut f64,
-) {
-    let s0 = guard.pose().scale;
-    let po = plane_icp::PlaneIcpOptions {
-        scale_lo: (s0 / 1.10).max(icp.scale_lo),
-        scale_hi: (s0 * 1.10).min(icp.scale_hi),
-        offset: true,
-        offset_max: OFFSET_MAX * s0 * object.diagonal(),
-        ..*pl
-    };
-    let (t, r, _) = plane_icp::plane_icp_offset(object, matcher, g_icp, guard.pose(), &po);
-    guard.measure_offsets(OFFSET_MAX);
-    if guard.offer("point_to_plane_offset", t) {
-        *rms = r;
     }
 }
 
@@ -580,6 +560,25 @@ pub fn compose(inputs: &[ObjectInput], o: &ComposeOptions) -> Result<Composition
         let mut pose_stage = reg.pose_stage.clone();
         let mut stages = reg.stages.clone();
         let mut refinement = None;
+        let mut contact = None;
+        // An item's size from its resting contact with the placed objects, where the guidance
+        // does not show it ([`contact_scale`]); the guard decides, within the guidance's noise.
+        if let (Some(f), Some(c), true) = (&field, &o.contact, rank > 0 && o.method.refines()) {
+            let (st, all) = (&mut pose_stage, &mut stages);
+            let r = contact_scale::apply(
+                &inp.visual,
+                &object,
+                &object_tree,
+                spacing,
+                guidance,
+                f,
+                c,
+                &mut t,
+                st,
+                all,
+            );
+            contact = Some(r);
+        }
         // The object's welded mesh, built once for the dense check and the anchor field.
         let geometry = std::cell::OnceCell::new();
         let geometry = || geometry.get_or_init(|| inp.visual.geometry());
@@ -691,6 +690,7 @@ pub fn compose(inputs: &[ObjectInput], o: &ComposeOptions) -> Result<Composition
             hypotheses: reg.hypotheses,
             colour_used,
             refinement,
+            contact,
         });
     }
     Ok(Composition {

@@ -9,7 +9,8 @@
 //!   along itself and go all the way in; the scale comes from how the surfaces overlap.
 //! - [`plane_icp_offset`]: the same fit with a normal offset δ shared by the whole object
 //!   (residual n·(sRx + t − g) + δ): a reconstruction that fattens or erodes the guidance by a
-//!   roughly constant depth then stops reading as scale.
+//!   roughly constant depth then stops reading as scale; [`offset_stage`] runs it in the
+//!   pipeline and offers its pose to the guard.
 //! - [`offset_fit`]: the guard's fit with the pose's own best offset taken out.
 //! - [`scale_offset_correlation`]: how far an object's shape lets scale and offset be told
 //!   apart (1 for a sphere or a cube: not at all).
@@ -337,6 +338,34 @@ pub fn scale_offset_correlation(object: &Cloud) -> f64 {
             }
         }
         None => 1.0,
+    }
+}
+
+/// The point-to-plane fit with a normal offset beside the scale (see [`super::OFFSET_MAX`]): a
+/// reconstruction's blur fattens or erodes the guidance by a roughly constant depth, which a
+/// similarity alone reads as scale. From then on the guard judges every pose with its own
+/// offset taken out.
+pub(super) fn offset_stage(
+    object: &Cloud,
+    matcher: &Matcher,
+    g_icp: &Cloud,
+    pl: &PlaneIcpOptions,
+    icp: &super::icp::IcpOptions,
+    guard: &mut super::guard::Guard,
+    rms: &mut f64,
+) {
+    let s0 = guard.pose().scale;
+    let po = PlaneIcpOptions {
+        scale_lo: (s0 / 1.10).max(icp.scale_lo),
+        scale_hi: (s0 * 1.10).min(icp.scale_hi),
+        offset: true,
+        offset_max: super::OFFSET_MAX * s0 * object.diagonal(),
+        ..*pl
+    };
+    let (t, r, _) = plane_icp_offset(object, matcher, g_icp, guard.pose(), &po);
+    guard.measure_offsets(super::OFFSET_MAX);
+    if guard.offer("point_to_plane_offset", t) {
+        *rms = r;
     }
 }
 

@@ -5,7 +5,8 @@
 //! - [`load_object`]: one of the shared scanned objects, Y-up, normalised like a generator's
 //!   output (centred, longest extent 1), with its true size in metres;
 //! - [`pair_scene`]: a support/container and an item, the support at a random yaw on the
-//!   floor, the item at its own random yaw dropped onto (into) the support until it rests;
+//!   floor, the item at its own random yaw dropped onto (into) the support until its mesh is
+//!   [`REST_CLEARANCE`] of its diagonal above the support's mesh;
 //! - [`make`]: the guidance parts: a dense reconstruction (20k–70k triangles, by subdividing the
 //!   placed object — not the decimation of [`super::synth`]), a hole around the contact, three
 //!   random holes each of radius 12 % of the object's diagonal, Gaussian vertex noise of 0.3 % of
@@ -99,9 +100,17 @@ fn yaw(rng: &mut Rng) -> UnitQuaternion<f64> {
     UnitQuaternion::from_axis_angle(&Vector3::y_axis(), rng.range(0.0, std::f64::consts::TAU))
 }
 
+/// Clearance of a true item above what it rests on, as a fraction of its diagonal: the contact
+/// tolerance of [`super::contact_scale::ContactOptions`] (a gap below it is contact), so the
+/// truth is in contact by the pipeline's own measure at every object size (a fixed 0.5 mm would
+/// be 1.6 % of a Duplo brick's diagonal and 0.1 % of a board's).
+pub const REST_CLEARANCE: f64 = 1e-3;
+
 /// The support at a random yaw with its lowest point on y = 0; the item upright at its own
-/// random yaw, offset at random within `spread` of the support's half footprint, lowered until
-/// it rests on (or in) the support with a clearance of 0.5 mm. Names: `support`, `item`.
+/// random yaw, offset at random within `spread` of the support's half footprint, dropped onto
+/// the support's column height field and then lowered along gravity until its exact distance to
+/// the support's mesh (or the floor) is [`REST_CLEARANCE`] of its diagonal
+/// ([`super::rest::lower_to_clearance`]). Names: `support`, `item`.
 pub fn pair_scene(
     support: &SourceObject,
     item: &SourceObject,
@@ -158,6 +167,14 @@ pub fn pair_scene(
         lift = -i_bb.min.y;
     }
     i_pose.translation.y += lift + 5e-4;
+    // The columns clear the support conservatively (up to 4 % of the item's diagonal): lower
+    // the item along gravity to an exact clearance above the support's mesh or the floor.
+    let s_mesh = support.visual.geometry().transformed(&s_pose.matrix());
+    let i_mesh = item.visual.geometry().transformed(&i_pose.matrix());
+    let diagonal =
+        crate::mesh::Aabb::of_points(&i_mesh.vertices).map_or(0.0, |b| b.extents().norm());
+    let (drop, _) = super::rest::lower_to_clearance(&s_mesh, &i_mesh, REST_CLEARANCE * diagonal);
+    i_pose.translation.y -= drop;
     vec![
         TruthObject {
             name: "support".into(),
