@@ -166,11 +166,12 @@ pub fn run(args: &[String]) {
         .map(|s| s.split(',').map(str::to_string).collect())
         .unwrap_or_default();
     let verbose = args.iter().any(|a| a == "-v");
-    // The contact-scale stage: `on` (default), `off`, `ungated` (no coverage gate: the gap,
-    // the lever and the guard decide) or `grow` (ungated, floating items only).
+    // The contact-scale stage: `off` (default, as `compose`), `on` (gated), `ungated` (no
+    // coverage gate: the gap, the lever and the guard decide) or `grow` (ungated, floating
+    // items only).
     let contact = match value("--contact").map(String::as_str) {
-        None | Some("on") => Some(ContactOptions::default()),
-        Some("off") => None,
+        Some("on") => Some(ContactOptions::default()),
+        None | Some("off") => None,
         Some("ungated") => Some(ContactOptions {
             coverage_max: f64::INFINITY,
             ..Default::default()
