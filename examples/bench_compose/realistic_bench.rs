@@ -166,21 +166,17 @@ pub fn run(args: &[String]) {
         .map(|s| s.split(',').map(str::to_string).collect())
         .unwrap_or_default();
     let verbose = args.iter().any(|a| a == "-v");
-    // The contact-scale stage: `off` (default, as `compose`), `on` (gated), `ungated` (no
-    // coverage gate: the gap, the lever and the guard decide) or `grow` (ungated, floating
-    // items only).
+    // The contact-scale stage: `grow` (default, as `compose`: ungated, floating items only),
+    // `off`, `on` (gated) or `ungated` (no coverage gate: the gap, the lever and the guard
+    // decide).
     let contact = match value("--contact").map(String::as_str) {
         Some("on") => Some(ContactOptions::default()),
-        None | Some("off") => None,
+        Some("off") => None,
         Some("ungated") => Some(ContactOptions {
             coverage_max: f64::INFINITY,
             ..Default::default()
         }),
-        Some("grow") => Some(ContactOptions {
-            coverage_max: f64::INFINITY,
-            grow_only: true,
-            ..Default::default()
-        }),
+        None | Some("grow") => Some(ContactOptions::grow()),
         Some(other) => {
             eprintln!("--contact {other}: expected on, off, ungated or grow");
             std::process::exit(2);

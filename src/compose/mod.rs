@@ -116,10 +116,9 @@ pub struct ComposeOptions {
     pub object_samples: usize,
     pub guidance_samples: usize,
     pub refine: RefineOptions,
-    /// The contact-scale stage's settings; `None` (the default) switches the stage off. Off by
-    /// default because only the stage off is measured on the whole realistic benchmark
-    /// (docs/compose.md, "Session 12"); grow-only with the gap probe is measured on five
-    /// pairs.
+    /// The contact-scale stage's settings; `None` switches the stage off. The default is
+    /// [`contact_scale::ContactOptions::grow`], the variant measured best on the whole
+    /// realistic benchmark (docs/compose.md, "Session 12").
     pub contact: Option<contact_scale::ContactOptions>,
 }
 
@@ -132,7 +131,7 @@ impl Default for ComposeOptions {
             object_samples: 5000,
             guidance_samples: 2500,
             refine: RefineOptions::default(),
-            contact: None,
+            contact: Some(contact_scale::ContactOptions::grow()),
         }
     }
 }
