@@ -132,11 +132,20 @@ pub struct Gap {
 
 /// min Φ over `points` (object frame) at pose `t`.
 pub fn gap(points: &[P3], t: &Similarity, field: &AnchorField) -> Gap {
-    let m = t.matrix();
-    let mut best = Gap {
+    let none = Gap {
         value: f64::INFINITY,
         normal: V3::zeros(),
     };
+    lowest(none, points.iter(), &t.matrix(), field)
+}
+
+/// The lowest of `best` and Φ at `points` moved by `m` (the first of equal values wins).
+fn lowest<'a>(
+    mut best: Gap,
+    points: impl Iterator<Item = &'a P3>,
+    m: &nalgebra::Matrix4<f64>,
+    field: &AnchorField,
+) -> Gap {
     for p in points {
         let (v, g) = field.eval(&m.transform_point(p));
         if v < best.value {
@@ -198,7 +207,7 @@ impl GapProbe {
             .collect();
         let mut order: Vec<usize> = (0..vals.len()).collect();
         order.sort_by(|&a, &b| vals[a].0.total_cmp(&vals[b].0).then(a.cmp(&b)));
-        let mut best = order.first().map_or(
+        let start = order.first().map_or(
             Gap {
                 value: f64::INFINITY,
                 normal: V3::zeros(),
@@ -208,18 +217,8 @@ impl GapProbe {
                 normal: vals[i].1,
             },
         );
-        for &i in order.iter().take(REFINE) {
-            for p in &self.cells[i] {
-                let (v, g) = field.eval(&m.transform_point(p));
-                if v < best.value {
-                    best = Gap {
-                        value: v,
-                        normal: g,
-                    };
-                }
-            }
-        }
-        best
+        let cells = order.iter().take(REFINE).flat_map(|&i| &self.cells[i]);
+        lowest(start, cells, &m, field)
     }
 }
 
