@@ -566,8 +566,7 @@ pub fn compose(inputs: &[ObjectInput], o: &ComposeOptions) -> Result<Composition
         // An item's size from its resting contact with the placed objects, where the guidance
         // does not show it ([`contact_scale`]); the guard decides, within the guidance's noise.
         if let (Some(f), Some(c), true) = (&field, &o.contact, rank > 0 && o.method.refines()) {
-            let (st, all) = (&mut pose_stage, &mut stages);
-            let r = contact_scale::apply(
+            contact = Some(contact_scale::apply(
                 &inp.visual,
                 &object,
                 &object_tree,
@@ -576,10 +575,9 @@ pub fn compose(inputs: &[ObjectInput], o: &ComposeOptions) -> Result<Composition
                 f,
                 c,
                 &mut t,
-                st,
-                all,
-            );
-            contact = Some(r);
+                &mut pose_stage,
+                &mut stages,
+            ));
         }
         // The object's welded mesh, built once for the dense check and the anchor field.
         let geometry = std::cell::OnceCell::new();

@@ -4,7 +4,7 @@
 //! [`Surface::project_until`], used by [`Surface::max_distance_until`].
 
 use super::geom::{Surface, WITHIN_MARGIN};
-use parry3d_f64::math::{Pose, Real, Vector};
+use parry3d_f64::math::{Real, Vector};
 use parry3d_f64::query::{PointProjection, PointQuery, PointQueryWithLocation};
 use parry3d_f64::shape::TrianglePointLocation;
 
@@ -24,11 +24,8 @@ impl Surface {
     /// parry's projection of `q` onto the surface (`TriMesh::project_point`, not solid), to
     /// the bit: see [`Surface::project_within`].
     pub(super) fn project(&self, q: Vector) -> PointProjection {
-        let m = Pose::identity();
-        let local = m.inverse_transform_point(q);
-        self.project_local(local, Real::MAX)
-            .unwrap_or(PointProjection::new(false, local))
-            .transform_by(&m)
+        self.project_local(q, Real::MAX)
+            .unwrap_or(PointProjection::new(false, q))
     }
 
     /// parry's `project_point_with_max_dist(identity, q, false, max_dist)`, to the bit: the
@@ -43,9 +40,7 @@ impl Surface {
     /// walks the same boxes: the answer is the same triangle, point and flag. A degenerate
     /// triangle (a zero normal) is never skipped.
     pub(super) fn project_within(&self, q: Vector, max_dist: Real) -> Option<PointProjection> {
-        let m = Pose::identity();
-        self.project_local(m.inverse_transform_point(q), max_dist)
-            .map(|proj| proj.transform_by(&m))
+        self.project_local(q, max_dist)
     }
 
     /// parry's `TriMesh::project_local_point_and_get_location_with_max_dist` (3D, not
@@ -147,7 +142,7 @@ mod tests {
             cuboid(V3::new(1.0, 0.5, 0.25)),
             sliver,
         ];
-        let id = Pose::identity();
+        let id = parry3d_f64::math::Pose::identity();
         let mut rng = crate::rng::Rng::new(37);
         let mut checked = 0usize;
         for mesh in &meshes {

@@ -211,14 +211,14 @@ pub(super) fn unfill(
     } else {
         (rounds, 1)
     };
-    // The union measure of `parts`, taken at the first move that passes the face planes, and
-    // the union checks left (see [`union_checks`]).
-    let mut union_est: Option<f64> = None;
+    // Whether the union measure of `parts` was taken (at the first move that passes the face
+    // planes), and the union checks left (see [`union_checks`]).
+    let mut union_measured = false;
     let mut checks = 0;
     let mut stuck = vec![false; parts.len()];
     let mut kept = 0;
     for _ in 0..2 * rounds {
-        if kept >= rounds || (union_est.is_some() && checks == 0) {
+        if kept >= rounds || (union_measured && checks == 0) {
             break;
         }
         let Some(w) = (0..parts.len())
@@ -297,9 +297,9 @@ pub(super) fn unfill(
             next_fill.extend([fa, fb, mf]);
             // The union measure of `parts` once a move reaches this point (objects whose
             // splits or merges all fail above never pay for it), and the checks it allows.
-            if union_mode && union_est.is_none() {
+            if union_mode && !union_measured {
                 let u = back_to_union(s, parts, &pts);
-                union_est = Some(u);
+                union_measured = true;
                 est = h2m_p95.max(u);
                 checks = union_checks(u - h2m_p95);
             }
