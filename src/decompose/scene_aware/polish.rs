@@ -148,14 +148,10 @@ impl Samples {
             .map(move |k| dist[k])
     }
 
-    /// Area of the visible surface farther than `thr` from the mesh.
-    fn excess(&self, s: &Surface, all: &[&Hull], skip: &[usize], eps: f64, thr: f64) -> f64 {
-        self.excess_while(s, all, skip, eps, thr, 0.0, &|_| true)
-            .expect("always kept")
-    }
-
-    /// [`Samples::excess`], or `None` as soon as `base` plus the excess counted so far fails
-    /// `ok` (which must then fail for anything larger: the count only grows).
+    /// The area of the visible surface (outside every hull of `all` but those at `skip`)
+    /// farther than `thr` from the mesh (its excess), or `None` as soon as `base` plus the
+    /// excess counted so far fails `ok` (which must then fail for anything larger: the count
+    /// only grows).
     #[allow(clippy::too_many_arguments)]
     fn excess_while(
         &self,
@@ -222,27 +218,29 @@ pub(super) fn polish(
             .collect()
     };
     let mut smp = sample_all(parts);
-    let mut cur = measure_parts(s, parts, &smp, eps);
+    let mut vis = visible_all(s, parts, &smp, eps);
+    let mut cur = measure(&vis);
     if cur.0 <= p.tol {
         return (0, 0);
     }
     let trimmed = trim(s, p, opts, parts, &is_pinned);
     if trimmed > 0 {
         smp = sample_all(parts);
-        cur = measure_parts(s, parts, &smp, eps);
+        vis = visible_all(s, parts, &smp, eps);
+        cur = measure(&vis);
     }
     let mut ids: Vec<u64> = (0..parts.len() as u64).collect();
     let mut next_id = parts.len() as u64;
+    // The adjacency of the parts named by the ids (see `adjacency`).
+    let mut adj_at: (Vec<u64>, Vec<Vec<usize>>) = (Vec::new(), Vec::new());
     // Merges by the pair of part ids; `None`: none, or one lifting a hull above a floor.
     let mut merged: BTreeMap<(u64, u64), Option<Sampled>> = BTreeMap::new();
     // Lifts of the current parts, by id.
     let mut lift_of: BTreeMap<u64, f64> = BTreeMap::new();
     let mut stuck: Vec<u64> = Vec::new();
     let (mut kept, mut failed) = (0, 0);
-    // What a round measures on the parts as they are, kept while no move is: the same hulls,
-    // samples and threshold give the same excesses (each hull's, and each merge's by the
-    // pair of part ids).
-    let mut ex_of: Option<Vec<f64>> = None;
+    // The merges' excesses, by the pair of part ids, kept while no move is: the same hulls,
+    // samples and threshold give the same excesses.
     let mut merge_ex: BTreeMap<(u64, u64), f64> = BTreeMap::new();
     for _ in 0..2 * rounds {
         if kept >= rounds || failed >= MAX_FAILS || parts.len() < 3 || cur.0 <= p.tol {
@@ -251,14 +249,11 @@ pub(super) fn polish(
         let thr = cur.0;
         let owned: Vec<Hull> = hulls_of(parts);
         let hulls: Vec<&Hull> = owned.iter().collect();
-        let ex: Vec<f64> = ex_of
-            .get_or_insert_with(|| {
-                (0..parts.len())
-                    .into_par_iter()
-                    .map(|i| smp[i].excess(s, &hulls, &[i], eps, thr))
-                    .collect()
-            })
-            .clone();
+        // Each hull's excess, from its visible points' distances (known for every current
+        // hull: `excess` would count the same points).
+        let ex: Vec<f64> = (0..parts.len())
+            .map(|i| excess_of(&smp[i], &vis[i], thr))
+            .collect();
         let Some(w) = (0..parts.len())
             .filter(|&i| {
                 parts[i].tris.len() >= 2
@@ -270,7 +265,12 @@ pub(super) fn polish(
         else {
             break;
         };
-        let adj = adjacency(s, parts);
+        // The parts change only with their ids: a round after one that kept no move finds
+        // the same adjacency.
+        if adj_at.0 != ids {
+            adj_at = (ids.clone(), adjacency(s, parts));
+        }
+        let adj = &adj_at.1;
         let lifts: Vec<f64> = lifts_by_id(s, parts, &ids, &mut lift_of);
         let top = |i: usize, j: usize| lifts[i].max(lifts[j]).max(CONTACT_DEV * p.tol);
         // Of the ways to split in two, the one leaving least excess, with the other hulls but
@@ -310,7 +310,7 @@ pub(super) fn polish(
                     .min_by(|x, y| x.0.total_cmp(&y.0).then(x.1.cmp(&y.1)))
             };
         // Move 1: the merge adding least excess, w split the way leaving least.
-        let pairs: Vec<(usize, usize)> = adjacent_pairs(&adj, w);
+        let pairs: Vec<(usize, usize)> = adjacent_pairs(adj, w);
         let missing: Vec<(usize, usize)> = pairs
             .iter()
             .copied()
@@ -369,7 +369,7 @@ pub(super) fn polish(
                 }
             }
         }
-        let mut done = try_move(s, parts, &mut smp, &trial, &mut cur, eps);
+        let mut done = try_move(s, parts, &mut smp, &mut vis, &trial, &mut cur, eps);
         if done {
             for &(k, _) in &trial {
                 ids[k] = next_id;
@@ -408,7 +408,15 @@ pub(super) fn polish(
                 })
                 .min_by(|x, y| x.0.total_cmp(&y.0).then(x.1.cmp(&y.1)));
             if let Some((_, j, a, b)) = best {
-                done = try_move(s, parts, &mut smp, &[(w, a), (j, b)], &mut cur, eps);
+                done = try_move(
+                    s,
+                    parts,
+                    &mut smp,
+                    &mut vis,
+                    &[(w, a), (j, b)],
+                    &mut cur,
+                    eps,
+                );
                 if done {
                     for k in [w, j] {
                         ids[k] = next_id;
@@ -418,7 +426,6 @@ pub(super) fn polish(
             }
         }
         if done {
-            ex_of = None;
             merge_ex.clear();
             kept += 1;
             failed = 0;
@@ -431,11 +438,18 @@ pub(super) fn polish(
 }
 
 /// Apply `trial` (part index, replacement) when it lowers the tail measure of `cur`
-/// (p95, tail) by [`MIN_GAIN`], and update `cur`.
+/// (p95, tail) by [`MIN_GAIN`], and update `cur` and `vis` (each hull's visible distances).
+///
+/// Only the hulls whose points' box meets a replaced hull's box, before or after the move
+/// (grown by `eps`, the test [`Samples::covering`] makes), and the replacements have their
+/// visible points measured again: for any other hull the hulls that may cover its points are
+/// the same, so its visible points are too. The distances are then those of measuring every
+/// hull, and `measure` sorts them: the same figures, to the bit.
 fn try_move(
     s: &Surface,
     parts: &mut [Part],
     smp: &mut [Arc<Samples>],
+    vis: &mut [Vec<f64>],
     trial: &[(usize, Sampled)],
     cur: &mut (f64, f64),
     eps: f64,
@@ -450,11 +464,36 @@ fn try_move(
         hulls[*k] = &q.hull;
         samples[*k] = qs;
     }
-    let v = measure(s, &hulls, &samples, eps);
+    let boxes: Vec<(&Aabb, &Aabb)> = trial
+        .iter()
+        .map(|(k, (q, _))| (&parts[*k].hull.aabb, &q.hull.aabb))
+        .collect();
+    let again: Vec<Option<Vec<f64>>> = (0..hulls.len())
+        .into_par_iter()
+        .map(|i| {
+            let on = &samples[i].aabb;
+            let moved = trial.iter().any(|(k, _)| *k == i)
+                || boxes
+                    .iter()
+                    .any(|(a, b)| a.intersects(on, eps) || b.intersects(on, eps));
+            moved.then(|| samples[i].visible(s, &hulls, &[i], eps).collect())
+        })
+        .collect();
+    let lists: Vec<&[f64]> = again
+        .iter()
+        .zip(vis.iter())
+        .map(|(a, v)| a.as_deref().unwrap_or(v))
+        .collect();
+    let v = measure(&lists);
     if v.1 < cur.1 * (1.0 - MIN_GAIN) {
         for (k, (q, qs)) in trial {
             parts[*k] = q.clone();
             smp[*k] = qs.clone();
+        }
+        for (i, a) in again.into_iter().enumerate() {
+            if let Some(a) = a {
+                vis[i] = a;
+            }
         }
         *cur = v;
         true
@@ -463,12 +502,22 @@ fn try_move(
     }
 }
 
-/// The 95th percentile of the sampled distances from the parts' union boundary to the mesh,
-/// and the mean of their farthest [`TAIL`] (m).
-fn measure(s: &Surface, hulls: &[&Hull], smp: &[&Samples], eps: f64) -> (f64, f64) {
-    let mut d: Vec<f64> = (0..hulls.len())
+/// Each part's visible sampled distances (outside every other hull, see
+/// [`Samples::visible`]).
+fn visible_all(s: &Surface, parts: &[Part], smp: &[Arc<Samples>], eps: f64) -> Vec<Vec<f64>> {
+    let hulls: Vec<&Hull> = parts.iter().map(|q| &q.hull).collect();
+    (0..hulls.len())
         .into_par_iter()
-        .flat_map_iter(|i| smp[i].visible(s, hulls, &[i], eps).collect::<Vec<_>>())
+        .map(|i| smp[i].visible(s, &hulls, &[i], eps).collect())
+        .collect()
+}
+
+/// The 95th percentile of the sampled distances from the parts' union boundary to the mesh
+/// (each hull's visible ones, `vis`), and the mean of their farthest [`TAIL`] (m).
+fn measure<V: AsRef<[f64]>>(vis: &[V]) -> (f64, f64) {
+    let mut d: Vec<f64> = vis
+        .iter()
+        .flat_map(|v| v.as_ref().iter().copied())
         .collect();
     if d.is_empty() {
         return (f64::INFINITY, f64::INFINITY);
@@ -479,11 +528,11 @@ fn measure(s: &Surface, hulls: &[&Hull], smp: &[&Samples], eps: f64) -> (f64, f6
     (p95, d[k..].iter().sum::<f64>() / (d.len() - k) as f64)
 }
 
-/// [`measure`] of the parts with their samples.
-fn measure_parts(s: &Surface, parts: &[Part], smp: &[Arc<Samples>], eps: f64) -> (f64, f64) {
-    let hulls: Vec<&Hull> = parts.iter().map(|q| &q.hull).collect();
-    let samples: Vec<&Samples> = smp.iter().map(|x| &**x).collect();
-    measure(s, &hulls, &samples, eps)
+/// A hull's excess (see [`Samples::excess_while`]) from its visible points' distances `vis`: the
+/// same count of visible points farther than `thr`, the same arithmetic.
+fn excess_of(smp: &Samples, vis: &[f64], thr: f64) -> f64 {
+    let far = vis.iter().filter(|&&d| d > thr).count();
+    smp.area * far as f64 / smp.pts.len() as f64
 }
 
 /// Before the moves, each patch (in order) gives up the triangles another part's hull already

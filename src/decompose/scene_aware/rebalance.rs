@@ -51,6 +51,8 @@ pub(super) fn rebalance(
     let is_pinned = |tris: &[u32], dev: f64| pinned(near, tris, dev, p, opts);
     let mut ids: Vec<u64> = (0..parts.len() as u64).collect();
     let mut next_id = parts.len() as u64;
+    // The adjacency of the parts named by the ids (see [`adjacency`]).
+    let mut adj_at: (Vec<u64>, Vec<Vec<usize>>) = (Vec::new(), Vec::new());
     // Merges, with their lift, by the pair of part ids; lifts of the current parts by id.
     let mut merged: BTreeMap<(u64, u64), Option<(Part, f64)>> = BTreeMap::new();
     let mut lift_of: BTreeMap<u64, f64> = BTreeMap::new();
@@ -79,9 +81,14 @@ pub(super) fn rebalance(
         if worst <= p.tol {
             break;
         }
-        let adj = adjacency(s, parts);
+        // The parts change only with their ids: a round after one that kept no move finds
+        // the same adjacency.
+        if adj_at.0 != ids {
+            adj_at = (ids.clone(), adjacency(s, parts));
+        }
+        let adj = &adj_at.1;
         // Adjacent pairs, w excluded, in index order.
-        let pairs: Vec<(usize, usize)> = adjacent_pairs(&adj, w);
+        let pairs: Vec<(usize, usize)> = adjacent_pairs(adj, w);
         // How far each hull rises above its patch's up-facing triangles.
         let lifts: Vec<f64> = lifts_by_id(s, parts, &ids, &mut lift_of);
         let missing: Vec<(usize, usize)> = pairs
