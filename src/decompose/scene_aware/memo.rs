@@ -70,17 +70,15 @@ impl KeyHasher {
     }
 }
 
-/// What building the part of a key found (see [`build_part_below`]). Unboxed though the variants differ in size: one
+/// What [`build_new_part`] found for a key. Unboxed though the variants differ in size: one
 /// per key in the memo, and a box would cost an allocation per build.
 #[allow(clippy::large_enum_variant)]
 #[derive(Clone, Debug)]
 pub(super) enum Built {
     /// The part (`None`: no hull).
     Done(Option<Part>),
-    /// Its hull deviates `dev` or more (the part's `dev`): it was not measured further. Kept
-    /// with the seam depth it is measured with, so that a later build below a higher bound
-    /// measures it further instead of building its hull again.
-    Above(Part, Option<f64>),
+    /// Its hull deviates this much or more: it was not measured further.
+    Above(f64),
 }
 
 impl Memo {
@@ -101,7 +99,7 @@ impl Memo {
         if let Ok(mut m) = self.parts.lock() {
             let more = match (m.get(&k), &v) {
                 (Some(Built::Done(_)), _) => false,
-                (Some(Built::Above(old, _)), Built::Above(new, _)) => new.dev > old.dev,
+                (Some(Built::Above(old)), Built::Above(new)) => new > old,
                 _ => true,
             };
             if more {

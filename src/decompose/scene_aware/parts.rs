@@ -1,7 +1,7 @@
 //! Patches and their hulls: the search's parameters ([`Params`], [`Strategy`]), a part
 //! ([`Part`]: a patch of triangles and its hull) and how one is built and measured.
 //!
-//! Entry points: [`build_part`], [`build_part_below`], [`deviation`],
+//! Entry points: [`build_part`], [`build_part_below`], [`build_new_part`], [`deviation`],
 //! [`deviation_until`], [`inflate`].
 
 use super::*;
@@ -208,56 +208,34 @@ pub(super) fn build_part_below(
     bound: f64,
 ) -> Option<Part> {
     let key = Memo::key(&tris, &cuts);
-    // A part kept "above" a lower bound than this one is measured again, below this one: its
-    // hull is the one it would be built with again (`unmeasured` is a pure function of
-    // the key), only its deviation was stopped short.
+    // A part kept "above" a lower bound than this one says nothing here: built again.
     let built = match p.memo.get(&key) {
-        Some(Built::Above(q, seams)) if q.dev < bound => {
-            let b = judged(measured(s, q, seams, bound), seams, bound);
-            p.memo.put(key, b.clone());
-            b
-        }
-        Some(known) => known,
-        None => {
-            let b = match unmeasured(s, p, opts, tris, cuts) {
-                Some((q, seams)) => judged(measured(s, q, seams, bound), seams, bound),
-                None => Built::Done(None),
-            };
-            p.memo.put(key, b.clone());
-            b
-        }
+        Some(Built::Above(dev)) if dev < bound => None,
+        known => known,
     };
+    let built = built.unwrap_or_else(|| {
+        let b = match build_new_part(s, p, opts, tris, cuts, bound) {
+            Some(q) if q.dev >= bound => Built::Above(q.dev),
+            part => Built::Done(part),
+        };
+        p.memo.put(key, b.clone());
+        b
+    });
     match built {
         Built::Done(part) => part.filter(|q| q.dev < bound),
-        Built::Above(..) => None,
+        Built::Above(_) => None,
     }
 }
 
-/// What the memo keeps of a part measured below `bound`.
-fn judged(q: Part, seams: Option<f64>, bound: f64) -> Built {
-    if q.dev >= bound {
-        Built::Above(q, seams)
-    } else {
-        Built::Done(Some(q))
-    }
-}
-
-/// The part `q` with its deviation (see [`deviation_until`]) measured until `bound`; `seams`
-/// as built (see [`unmeasured`]).
-fn measured(s: &Surface, mut q: Part, seams: Option<f64>, bound: f64) -> Part {
-    q.dev = deviation_until(s, &q.hull, q.tris[0] as u64, &q.outer, seams, bound);
-    q
-}
-
-/// The part of a patch, its deviation not measured yet (NaN), and the seam depth to measure
-/// it with (`None`: every point counts; see [`deviation`]).
-fn unmeasured(
+/// [`build_part_below`] without the memo: the part, its deviation measured until `bound`.
+pub(super) fn build_new_part(
     s: &Surface,
     p: &Params,
     opts: &DecomposeOptions,
     tris: Vec<u32>,
     cuts: Vec<(V3, f64)>,
-) -> Option<(Part, Option<f64>)> {
+    bound: f64,
+) -> Option<Part> {
     let mut normal = V3::zeros();
     for &t in &tris {
         normal += s.tri_normal[t as usize] * s.tri_area[t as usize];
@@ -348,15 +326,22 @@ fn unmeasured(
     if hull.vertices.len() > opts.max_vertices {
         hull = hull.simplified(opts.max_vertices)?;
     }
-    let part = Part {
+    let dev = deviation_until(
+        s,
+        &hull,
+        tris[0] as u64,
+        &outer,
+        two_sided.then_some(p.seam_depth()),
+        bound,
+    );
+    Some(Part {
         tris,
         hull,
         outer,
         normal,
         cuts,
-        dev: f64::NAN,
-    };
-    Some((part, two_sided.then_some(p.seam_depth())))
+        dev,
+    })
 }
 
 /// A little of the volume a simplified hull `h` lost (`volume`: the original's) given back by a
