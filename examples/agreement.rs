@@ -192,6 +192,12 @@ fn set(o: &mut SettleOptions, kv: &str) {
         "contact_recycle_distance" => o.contact_recycle_distance = x,
         "probe_angle_deg" => o.probe_angle_deg = x,
         "probe_time" => o.probe_time = x,
+        "max_rest_motion" => o.max_rest_motion = x,
+        "max_rest_rotation_deg" => o.max_rest_rotation_deg = x,
+        "creep_max_motion" => o.creep_max_motion = x,
+        "creep_max_rotation_deg" => o.creep_max_rotation_deg = x,
+        "creep_contact_distance" => o.creep_contact_distance = x,
+        "creep_max_imbalance" => o.creep_max_imbalance = x,
         _ => {
             eprintln!("--set: unknown settle option {k}");
             std::process::exit(2)

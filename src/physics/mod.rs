@@ -13,7 +13,11 @@
 //! 2. **Rest**: from the settled state, with sleeping disabled so that creep cannot hide behind
 //!    the sleep heuristic, simulate some more: every object must stay put, and the contact
 //!    penetration, measured with exact f64 convex queries (not Rapier's possibly recycled contact
-//!    distances), must stay below a tolerance.
+//!    distances), must stay below a tolerance. A body that keeps creeping slowly (within
+//!    [`SettleOptions::creep_max_motion`] / `creep_max_rotation_deg`) passes when its contacts
+//!    hold it in static equilibrium inside their friction cones, without any solver (the
+//!    `creep` module, [`equilibrium`]): Rapier keeps some leaning items moving where MuJoCo
+//!    rests them.
 //!
 //! The API is independent of file formats: callers build [`SimBody`]s from whatever they export.
 //! Everything is deterministic: the same input gives a bitwise-identical [`SettleReport`].
@@ -30,6 +34,8 @@ use rapier3d_f64::prelude::{
 };
 use serde::Serialize;
 
+mod creep;
+pub mod equilibrium;
 mod fresh;
 pub mod load_ratio;
 pub mod probe;
@@ -188,6 +194,24 @@ pub struct SettleOptions {
     pub max_rest_motion: f64,
     /// Rest fails when the body turns more than this (degrees).
     pub max_rest_rotation_deg: f64,
+    /// The creep rule ([`creep`]): a body that moved past `max_rest_motion` /
+    /// `max_rest_rotation_deg` in the rest check, but by at most this (m)...
+    pub creep_max_motion: f64,
+    /// ...and at most this (degrees), passes the rest check when its contacts at the settled
+    /// and the final pose hold it (and what it touches) in static equilibrium within their
+    /// friction cones (see [`equilibrium`]). 3 mm and 3°, three times the rest limits: Rapier's
+    /// creep of a leaning item was traced at 0.07–2.5 mm and 0.04–2.5° per second, steady for
+    /// 20 s; a body that falls, tips or rolls leaves that band within the second. 0 for either
+    /// disables the rule.
+    pub creep_max_rotation_deg: f64,
+    /// Contact points closer than this (m) take part in the creep rule's equilibrium (0.2 mm:
+    /// ten times the depth a soft contact sinks to under an item's weight here, far below the
+    /// 2 mm at which the support graph calls two bodies touching).
+    pub creep_contact_distance: f64,
+    /// The equilibrium holds when the unbalanced wrench is at most this fraction of the group's
+    /// weight. 1e-5: a body accelerated by that fraction of g moves 0.05 mm in the 1 s rest
+    /// check, a twentieth of its limit; a network that truly balances leaves round-off (1e-15).
+    pub creep_max_imbalance: f64,
     /// Rest fails when a contact penetrates deeper than this (m) at any step of the rest phase.
     pub max_rest_penetration: f64,
     /// The composed pose fails when two objects (or an object and the floor) interpenetrate
@@ -246,6 +270,10 @@ impl Default for SettleOptions {
             max_settle_rotation_deg: 30.0,
             max_rest_motion: 0.001,
             max_rest_rotation_deg: 1.0,
+            creep_max_motion: 0.003,
+            creep_max_rotation_deg: 3.0,
+            creep_contact_distance: 0.0002,
+            creep_max_imbalance: 1e-5,
             max_rest_penetration: 0.001,
             max_initial_penetration: 0.001,
             support_distance: 0.002,
@@ -336,6 +364,11 @@ pub struct BodyReport {
     /// probe off.
     pub probe_displacement: f64,
     pub probe_rotation_deg: f64,
+    /// Set when the creep rule ([`SettleOptions::creep_max_motion`]) looked at this body: the
+    /// unbalanced wrench of its contacts as a fraction of its group's weight (the worse of the
+    /// settled and the final pose). Absent otherwise.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub creep_imbalance: Option<f64>,
 }
 
 /// The outcome of [`settle`].

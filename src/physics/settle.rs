@@ -75,6 +75,17 @@ pub fn settle(bodies: &[SimBody], opts: &SettleOptions) -> Result<SettleReport, 
         }
     }
     let finals: Vec<Isometry3<f64>> = (0..n).map(|i| sim.pose(i)).collect();
+    // The creep rule: only when some body moved past the rest limits within the creep band.
+    let creeping = |i: usize| {
+        (rest_disp[i] > opts.max_rest_motion || rest_rot[i] > opts.max_rest_rotation_deg)
+            && rest_disp[i] <= opts.creep_max_motion
+            && rest_rot[i] <= opts.creep_max_rotation_deg
+    };
+    let imbalance = if dynamic.iter().any(|&i| creeping(i)) {
+        super::creep::creep_balance(&sim, &settled, &finals, opts.creep_contact_distance)
+    } else {
+        vec![f64::INFINITY; n]
+    };
     let probed = super::probe::probe(bodies, &finals, &loaded, opts)?;
 
     // Verdicts.
@@ -158,7 +169,17 @@ pub fn settle(bodies: &[SimBody], opts: &SettleOptions) -> Result<SettleReport, 
                     names(&sim, &body_supports)
                 ));
             }
-            if rest_disp[i] > opts.max_rest_motion {
+            let crept = creeping(i) && imbalance[i] <= opts.creep_max_imbalance;
+            if crept {
+                notes.push(format!(
+                    "crept {:.2} mm / {:.2}° during the {} s rest check, but its contacts hold it at rest (unbalanced {:.1e} of its weight): the solver's creep, not counted",
+                    mm(rest_disp[i]),
+                    rest_rot[i],
+                    opts.rest_time,
+                    imbalance[i]
+                ));
+            }
+            if rest_disp[i] > opts.max_rest_motion && !crept {
                 reasons.push(format!(
                     "moved {:.2} mm during the {} s rest check (> {:.2} mm)",
                     mm(rest_disp[i]),
@@ -166,7 +187,7 @@ pub fn settle(bodies: &[SimBody], opts: &SettleOptions) -> Result<SettleReport, 
                     mm(opts.max_rest_motion)
                 ));
             }
-            if rest_rot[i] > opts.max_rest_rotation_deg {
+            if rest_rot[i] > opts.max_rest_rotation_deg && !crept {
                 reasons.push(format!(
                     "turned {:.2}° during the {} s rest check (> {:.2}°)",
                     rest_rot[i], opts.rest_time, opts.max_rest_rotation_deg
@@ -224,6 +245,7 @@ pub fn settle(bodies: &[SimBody], opts: &SettleOptions) -> Result<SettleReport, 
             marginal,
             probe_displacement,
             probe_rotation_deg,
+            creep_imbalance: (!b.fixed && creeping(i)).then_some(imbalance[i]),
         });
     }
     let marginal: Vec<String> = reports

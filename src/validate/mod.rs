@@ -315,8 +315,13 @@ pub fn dynamic_checks(settle: &SettleReport, s: &crate::physics::SettleOptions) 
                     .join("; ")
             },
         });
-        let rest_ok = b.rest_displacement <= s.max_rest_motion
-            && b.rest_rotation_deg <= s.max_rest_rotation_deg
+        // A body the creep rule let through (physics::creep) has no "rest check" reason.
+        let crept = b
+            .creep_imbalance
+            .is_some_and(|r| r <= s.creep_max_imbalance);
+        let rest_ok = ((b.rest_displacement <= s.max_rest_motion
+            && b.rest_rotation_deg <= s.max_rest_rotation_deg)
+            || crept)
             && b.rest_max_penetration <= s.max_rest_penetration;
         checks.push(Check {
             name: "rest".into(),
