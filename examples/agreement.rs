@@ -8,14 +8,20 @@
 //!
 //! Run: `nice cargo run --release --example agreement -- [--seeds 0..300] [--out DIR]
 //!       [--objects DIR] [--batch 10] [--keep] [--physx] [--physx-every K] [--only S1,S2]
-//!       [--set KEY=VALUE] [--max-hull-polygons N]` (`--max-hull-polygons 64`: the hulls a user
+//!       [--set KEY=VALUE] [--max-hull-polygons N] [--nudge]` (`--nudge`: for every verdict
+//! disagreement, our verdict again from the composed pose nudged by 0.5 mm / 0.5°, 8 starts a
+//! free body (`agreement::nudge`), written to OUT/nudges.jsonl and counted: a disagreement whose
+//! engine verdict some nudged start of ours shares is within our own spread; `--max-hull-polygons 64`: the hulls a user
 //! exporting for Isaac gets, the ones PhysX should judge; `--only`: these seeds instead; `--set`: a settle option, for
 //! experiments; `--physx-every K`:
 //! PhysX judges one batch in K, it is about 4x slower than MuJoCo; the judges' interpreter:
 //! `INTERACT3D_PYTHON`, default `python3`). Objects are decomposed once each and cached in
 //! `target/agreement-cache`.
 
-use interact3d::agreement::{judge::judge_with, run_scene_with, summary, Catalog, Judged, Summary};
+use interact3d::agreement::nudge::{self, Spread};
+use interact3d::agreement::{
+    judge::judge_with, run_scene_with, summary, Catalog, Generated, Judged, Summary,
+};
 use interact3d::physics::SettleOptions;
 use rayon::prelude::*;
 use std::io::Write;
@@ -32,6 +38,7 @@ fn main() {
     let mut only: Option<Vec<u64>> = None;
     let mut settle = SettleOptions::default();
     let mut max_polygons = usize::MAX;
+    let mut nudge = false;
     let mut args = std::env::args().skip(1);
     while let Some(a) = args.next() {
         match a.as_str() {
@@ -60,6 +67,7 @@ fn main() {
             }
             "--set" => set(&mut settle, &args.next().expect("--set KEY=VALUE")),
             "--physx" => physx = true,
+            "--nudge" => nudge = true,
             "--physx-every" => {
                 physx = true;
                 physx_every = args.next().expect("--physx-every K").parse().expect("K");
@@ -96,6 +104,9 @@ fn main() {
         std::fs::File::create(out.join("scenes_physx.jsonl")).expect("scenes_physx.jsonl")
     });
     let mut all: Vec<Judged> = Vec::new();
+    let mut nudge_lines =
+        nudge.then(|| std::fs::File::create(out.join("nudges.jsonl")).expect("nudges.jsonl"));
+    let mut nudged: Vec<(bool, Spread)> = Vec::new();
     let mut all_px: Vec<Judged> = Vec::new();
     let seed_list: Vec<u64> = only.clone().unwrap_or_else(|| seeds.clone().collect());
     for (k, chunk) in seed_list.chunks(batch).enumerate() {
@@ -136,6 +147,15 @@ fn main() {
                 let _ = std::fs::remove_dir_all(d);
             }
         }
+        if nudge {
+            let gens: Vec<_> = done.iter().map(|d| &d.0).collect();
+            nudged.extend(nudge_disagreements(
+                &gens,
+                &judged,
+                &settle,
+                &mut nudge_lines,
+            ));
+        }
         all.extend(judged);
         eprintln!("{} scenes, {:.0} s", all.len(), t.elapsed().as_secs_f64());
     }
@@ -149,6 +169,15 @@ fn main() {
         println!("seeds {o:?}");
     }
     print_table("MuJoCo", &(if only.is_some() { 0..0 } else { seeds }), &s);
+    if nudge {
+        let within = nudged.iter().filter(|(v, sp)| sp.includes(*v)).count();
+        let split = nudged.iter().filter(|(_, sp)| sp.undetermined()).count();
+        println!(
+            "verdict disagreements within our own nudged spread (0.5 mm / 0.5 deg): {within} of {} \
+             ({split} with our nudged verdicts split)",
+            nudged.len()
+        );
+    }
     if physx {
         let s = summary(&all_px);
         std::fs::write(
@@ -160,6 +189,54 @@ fn main() {
         println!("\nPhysX judged seeds: {seeds:?}");
         print_table("PhysX", &(0..0), &s);
     }
+}
+
+/// `--nudge`: our verdict over the nudged composed poses of each MuJoCo verdict disagreement
+/// (one line each to `lines`); returns (MuJoCo's verdict, our spread) of each.
+fn nudge_disagreements(
+    gens: &[&Generated],
+    judged: &[Judged],
+    settle: &SettleOptions,
+    lines: &mut Option<std::fs::File>,
+) -> Vec<(bool, Spread)> {
+    let todo: Vec<_> = judged
+        .iter()
+        .filter(|j| !j.verdict_agrees)
+        .filter_map(|j| gens.iter().find(|g| g.seed == j.seed).map(|g| (*g, j)))
+        .collect();
+    let res: Vec<_> = todo
+        .par_iter()
+        .filter_map(|(g, j)| match nudge::spread(g, settle) {
+            Ok(sp) => Some((j.seed, j.ours.passed, j.mujoco.passed, sp)),
+            Err(e) => {
+                eprintln!("seed {}: nudges: {e}", j.seed);
+                None
+            }
+        })
+        .collect();
+    res.into_iter()
+        .map(|(seed, ours, engine, sp)| {
+            eprintln!(
+                "seed {seed}: we {}, MuJoCo {}; nudged: {} of {} pass{}",
+                if ours { "pass" } else { "fail" },
+                if engine { "passes" } else { "fails" },
+                sp.passed,
+                sp.runs,
+                if sp.includes(engine) {
+                    " (MuJoCo's verdict within our spread)"
+                } else {
+                    ""
+                }
+            );
+            if let Some(f) = lines.as_mut() {
+                let v = serde_json::json!({"seed": seed, "ours": ours, "engine": engine,
+                    "nudged_runs": sp.runs, "nudged_passed": sp.passed,
+                    "within_spread": sp.includes(engine)});
+                writeln!(f, "{v}").expect("nudges.jsonl");
+            }
+            (engine, sp)
+        })
+        .collect()
 }
 
 /// `--set KEY=VALUE`: a settle option (experiments; the defaults are the library's).

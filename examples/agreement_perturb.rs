@@ -1,8 +1,8 @@
 //! Experiment (issue #33): settle one generated scene from its composed pose nudged by 0.5 mm or
-//! 0.5° (each body, ±x, ±y), and print each run's verdict and the bodies' settle motion.
+//! 0.5° (each free body, ±x, ±y: `agreement::nudge::nudged_poses`), and print each run's
+//! verdict and the bodies' settle motion.
 //! Run: `cargo run --release --example agreement_perturb -- SEED`
-use interact3d::agreement::Catalog;
-use nalgebra::{Isometry3, Translation3, UnitQuaternion, Vector3};
+use interact3d::agreement::{nudge::nudged_poses, Catalog};
 use std::path::PathBuf;
 
 fn main() {
@@ -41,32 +41,20 @@ fn main() {
         println!("{label:>16} passed={} {}", v.passed, s.join(" | "));
     };
     run("none", &g.assembly);
-    for i in 0..g.assembly.bodies.len() {
-        for (k, axis) in [Vector3::x(), -Vector3::x(), Vector3::y(), -Vector3::y()]
-            .iter()
-            .enumerate()
-        {
-            for kind in 0..2 {
-                let mut a = g.assembly.clone();
-                let b = &mut a.bodies[i];
-                let com = (b.pose * b.inertial.com).coords;
-                let d = if kind == 0 {
-                    let r = UnitQuaternion::from_axis_angle(
-                        &nalgebra::Unit::new_normalize(*axis),
-                        0.5f64.to_radians(),
-                    );
-                    Isometry3::from_parts(Translation3::from(com), r)
-                        * Isometry3::translation(-com.x, -com.y, -com.z)
-                } else {
-                    Isometry3::from_parts(
-                        Translation3::from(axis * 5e-4),
-                        UnitQuaternion::identity(),
-                    )
-                };
-                b.pose = d * b.pose;
-                b.composed_pose = d * b.composed_pose;
-                run(&format!("b{i} {} {k}", ["turn", "shift"][kind]), &a);
-            }
+    // The nudged starts of `agreement::nudge` (the ones `agreement --nudge` counts): each free
+    // body in turn, turned 0.5° about ±x, ±y through its centre of mass, then shifted 0.5 mm.
+    let a = &g.assembly;
+    let poses: Vec<_> = a.bodies.iter().map(|b| b.composed_pose).collect();
+    let coms: Vec<_> = a.bodies.iter().map(|b| b.inertial.com).collect();
+    let fixed: Vec<_> = a.bodies.iter().map(|b| b.fixed).collect();
+    let free: Vec<usize> = (0..a.bodies.len()).filter(|&i| !fixed[i]).collect();
+    for (k, p) in nudged_poses(&poses, &coms, &fixed).into_iter().enumerate() {
+        let mut n = a.clone();
+        for (b, q) in n.bodies.iter_mut().zip(p) {
+            b.pose = q;
+            b.composed_pose = q;
         }
+        let (body, kind, dir) = (free[k / 8], ["turn", "shift"][k % 8 / 4], k % 4);
+        run(&format!("b{body} {kind} {dir}"), &n);
     }
 }

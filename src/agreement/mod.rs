@@ -7,7 +7,8 @@
 //!
 //! Entry points: [`Catalog::load`] (objects decomposed once each, through the content-addressed
 //! decomposition cache), [`Catalog::compose`] (one seeded scene), [`run_scene`] (settle +
-//! export), [`judge`] (the MuJoCo side, in [`judge`]), [`summary`].
+//! export), [`judge`] (the MuJoCo side, in [`judge`]), [`summary`], [`nudge::spread`] (our
+//! verdict over nudged composed poses: is a disagreement within our own spread?).
 //!
 //! Definitions (what the table counts):
 //! - **verdict**: our validator's pass/fail against MuJoCo's, where MuJoCo's scene verdict is
@@ -16,6 +17,7 @@
 //!   started from the exported (settled) pose.
 
 pub mod judge;
+pub mod nudge;
 mod place;
 
 use crate::body::{build, Assembly, Body, BuildOptions};
