@@ -255,7 +255,12 @@ pub enum Skip {
 
 /// The visible part (object samples the guidance points pair with at `t`), the robust σ of the
 /// residuals and the smallest span of the visible part over the object's along its axes.
-fn visible(object: &Cloud, tree: &KdTree, guidance: &Cloud, t: &Similarity) -> (P3, f64, f64) {
+pub(super) fn visible(
+    object: &Cloud,
+    tree: &KdTree,
+    guidance: &Cloud,
+    t: &Similarity,
+) -> (P3, f64, f64) {
     let inv = t.rotation.inverse();
     let mut seen = vec![false; object.len()];
     let mut res = Vec::with_capacity(guidance.len());

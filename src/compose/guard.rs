@@ -8,7 +8,7 @@
 
 use super::cloud::Cloud;
 use super::kdtree::KdTree;
-use super::plane_icp::{offset_fit, surface_fit};
+use super::plane_icp::{offset_distances, offset_fit, surface_distances, surface_fit};
 use crate::mesh::{VisualMesh, P3};
 use crate::pose::Similarity;
 use serde::Serialize;
@@ -45,6 +45,8 @@ pub struct Guard<'a> {
     /// When set, fits take out each pose's own normal offset, up to this fraction of the
     /// object's diagonal at the pose's scale ([`offset_fit`]).
     offset_fraction: Option<f64>,
+    /// When set, the truncation in guidance units, the same for every pose ([`Guard::fix_cap`]).
+    cap_fixed: Option<f64>,
     best: Similarity,
     best_fit: f64,
     stage: String,
@@ -76,6 +78,7 @@ impl<'a> Guard<'a> {
             cap_fraction: 0.03,
             allowance: 0.0,
             offset_fraction: None,
+            cap_fixed: None,
             best: start,
             best_fit: f64::INFINITY,
             stage: stage.to_string(),
@@ -100,7 +103,7 @@ impl<'a> Guard<'a> {
     /// The fit of pose `t` and the normal offset taken out of it (0 unless measuring offsets).
     fn fit_offset(&self, t: &Similarity) -> (f64, f64) {
         let diag = t.scale * self.object.diagonal();
-        let cap = self.cap_fraction * diag;
+        let cap = self.cap_fixed.unwrap_or(self.cap_fraction * diag);
         match self.offset_fraction {
             None => (
                 surface_fit(self.object, self.tree, self.spacing, &self.probe, t, cap),
@@ -123,6 +126,42 @@ impl<'a> Guard<'a> {
     /// beside the scale is then judged against the current pose on the same terms.
     pub fn measure_offsets(&mut self, fraction: f64) -> &mut Self {
         self.offset_fraction = Some(fraction);
+        self.best_fit = self.fit(&self.best);
+        self
+    }
+
+    /// Each probe point's truncated distance at pose `t`, as [`Guard::fit`] averages them.
+    fn distances(&self, t: &Similarity) -> Vec<f64> {
+        let diag = t.scale * self.object.diagonal();
+        let cap = self.cap_fixed.unwrap_or(self.cap_fraction * diag);
+        match self.offset_fraction {
+            None => surface_distances(self.object, self.tree, self.spacing, &self.probe, t, cap),
+            Some(f) => {
+                let (o, tr, sp) = (self.object, self.tree, self.spacing);
+                offset_distances(o, tr, sp, &self.probe, t, cap, f * diag).0
+            }
+        }
+    }
+
+    /// Whether `t` fits better than the current pose beyond the probe's sampling error: the
+    /// mean of the per-point differences (same probe points, paired) is below −`z` standard
+    /// errors. A search that picks the best of many candidates by the fit also picks the
+    /// sampling noise; this keeps a gain that noise alone would not give.
+    pub fn clearly_better(&self, t: &Similarity, z: f64) -> bool {
+        let (a, b) = (self.distances(t), self.distances(&self.best));
+        let n = a.len().max(2) as f64;
+        let diff: Vec<f64> = a.iter().zip(&b).map(|(x, y)| x - y).collect();
+        let mean = diff.iter().sum::<f64>() / n;
+        let var = diff.iter().map(|d| (d - mean).powi(2)).sum::<f64>() / (n - 1.0);
+        mean < -z * (var / n).sqrt()
+    }
+
+    /// From now on every pose's distances are truncated at the current pose's cap (guidance
+    /// units), not at a fraction of each pose's own size: poses of different scales are then
+    /// charged the same for the guidance points no pose explains (bleed, blur), where a cap
+    /// proportional to the scale charges a smaller pose less for each of them.
+    pub fn fix_cap(&mut self) -> &mut Self {
+        self.cap_fixed = Some(self.cap_fraction * self.best.scale * self.object.diagonal());
         self.best_fit = self.fit(&self.best);
         self
     }

@@ -38,6 +38,7 @@ pub mod refine;
 pub mod rest;
 pub mod scale;
 pub mod sdf;
+pub mod sweep;
 pub mod synth;
 
 use crate::error::{Error, Result};
@@ -424,6 +425,13 @@ fn register(
         // scale. Judged by the guard with each pose's own offset taken out.
         if plane_icp::scale_offset_correlation(object) < OFFSET_CORRELATION_MAX {
             plane_icp::offset_stage(object, &matcher, &g_icp, &pl, &icp, &mut guard, &mut rms);
+            // Then the scale swept ±40 %, judged by the same offset-aware fit ([`sweep`]).
+            let (o, bounds) = (sweep::SweepOptions::default(), (icp.scale_lo, icp.scale_hi));
+            let m = &matcher;
+            let (ot, g) = (object_tree, &mut guard);
+            if let Some(r) = sweep::sweep(object, ot, m, &g_icp, &pl, bounds, OFFSET_MAX, g, &o) {
+                rms = r;
+            }
         }
     }
     let t = guard.pose();

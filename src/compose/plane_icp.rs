@@ -215,28 +215,42 @@ pub fn surface_fit(
     t: &Similarity,
     cap: f64,
 ) -> f64 {
+    let d = surface_distances(object, tree, spacing, guidance, t, cap);
+    d.iter().sum::<f64>() / guidance.len().max(1) as f64
+}
+
+/// The truncated distances [`surface_fit`] averages, one per guidance point.
+pub fn surface_distances(
+    object: &Cloud,
+    tree: &KdTree,
+    spacing: f64,
+    guidance: &[P3],
+    t: &Similarity,
+    cap: f64,
+) -> Vec<f64> {
     let Some(inv) = t.matrix().try_inverse() else {
-        return cap;
+        return vec![cap; guidance.len()];
     };
-    let mut sum = 0.0;
-    for q in guidance {
-        let x = inv.transform_point(q);
-        let d = match tree.nearest(&x) {
-            Some((j, d2)) => {
-                let along = (x - object.points[j]).dot(&object.normals[j]);
-                let tangential = (d2 - along * along).max(0.0).sqrt();
-                t.scale
-                    * if tangential < 2.0 * spacing {
-                        along.abs()
-                    } else {
-                        d2.sqrt()
-                    }
-            }
-            None => cap,
-        };
-        sum += d.min(cap);
-    }
-    sum / guidance.len().max(1) as f64
+    guidance
+        .iter()
+        .map(|q| {
+            let x = inv.transform_point(q);
+            let d = match tree.nearest(&x) {
+                Some((j, d2)) => {
+                    let along = (x - object.points[j]).dot(&object.normals[j]);
+                    let tangential = (d2 - along * along).max(0.0).sqrt();
+                    t.scale
+                        * if tangential < 2.0 * spacing {
+                            along.abs()
+                        } else {
+                            d2.sqrt()
+                        }
+                }
+                None => cap,
+            };
+            d.min(cap)
+        })
+        .collect()
 }
 
 /// [`surface_fit`] with the pose's own normal offset taken out: δ* is the median signed
@@ -254,8 +268,22 @@ pub fn offset_fit(
     cap: f64,
     offset_max: f64,
 ) -> (f64, f64) {
+    let (d, delta) = offset_distances(object, tree, spacing, guidance, t, cap, offset_max);
+    (d.iter().sum::<f64>() / guidance.len().max(1) as f64, delta)
+}
+
+/// The truncated distances [`offset_fit`] averages, one per guidance point, and δ*.
+pub fn offset_distances(
+    object: &Cloud,
+    tree: &KdTree,
+    spacing: f64,
+    guidance: &[P3],
+    t: &Similarity,
+    cap: f64,
+    offset_max: f64,
+) -> (Vec<f64>, f64) {
     let Some(inv) = t.matrix().try_inverse() else {
-        return (cap, 0.0);
+        return (vec![cap; guidance.len()], 0.0);
     };
     // (distance, signed along the normal?) per point.
     let d: Vec<(f64, bool)> = guidance
@@ -287,11 +315,11 @@ pub fn offset_fit(
         signed.sort_by(f64::total_cmp);
         signed[signed.len() / 2].clamp(-offset_max, offset_max)
     };
-    let sum: f64 = d
+    let out = d
         .iter()
         .map(|&(v, plane)| if plane { (v - delta).abs() } else { v }.min(cap))
-        .sum();
-    (sum / guidance.len().max(1) as f64, delta)
+        .collect();
+    (out, delta)
 }
 
 /// One point's row of the point-to-plane Jacobian about the centroid, `d = p − c`: rotation
