@@ -13,8 +13,9 @@
 //! (`scene::load`: files, meshes, textures), **prepare** (metres, Z-up, on the ground),
 //! **decompose** (the engine's `decompose` call, timed through a wrapper), **inertia** (the rest
 //! of `body::assemble`: the hulls' two-sided fidelity measure, mass properties, body frames),
-//! **validate** (metrics + settle) and **write** (`export::export` into a temporary folder). Each scene runs in a fresh child process
-//! (this executable again), so its peak RSS (`VmHWM`) is its own. CPU time is read from
+//! **validate** (metrics + settle) and **write** (`export::export` into a temporary folder).
+//! Each scene runs in a fresh child process (this executable again), so its peak RSS (`VmHWM`)
+//! is its own. CPU time is read from
 //! `/proc/self/stat` (Linux; 10 ms ticks). `--per-object` adds, for each object, the time to
 //! decompose its mesh alone, which is not the same work as its share of the scene (the scene
 //! engine also keeps hulls off the neighbours), but tells which objects are expensive.
