@@ -12,12 +12,15 @@
 //! Stages are the pipeline's own (`pipeline::export_scene` split into its calls): **load**
 //! (`scene::load`: files, meshes, textures), **prepare** (metres, Z-up, on the ground),
 //! **decompose** (the engine's `decompose` call, timed through a wrapper), **inertia** (the rest
-//! of `body::assemble`: mass properties, body frames), **validate** (metrics + settle) and
-//! **write** (`export::export` into a temporary folder). Each scene runs in a fresh child process
-//! (this executable again), so its peak RSS (`VmHWM`) is its own. CPU time is read from
+//! of `body::assemble`: the hulls' two-sided fidelity measure, mass properties, body frames),
+//! **validate** (metrics + settle) and **write** (`export::export` into a temporary folder).
+//! Each scene runs in a fresh child process (this executable again), so its peak RSS (`VmHWM`)
+//! is its own. CPU time is read from
 //! `/proc/self/stat` (Linux; 10 ms ticks). `--per-object` adds, for each object, the time to
 //! decompose its mesh alone, which is not the same work as its share of the scene (the scene
 //! engine also keeps hulls off the neighbours), but tells which objects are expensive.
+//! Most of **inertia** is the fidelity measure; the mass properties of a closed mesh take about
+//! 1 ms an object (`docs/speed.md`, ninth stop).
 
 use interact3d::body::{assemble, BuildOptions};
 use interact3d::decompose::{DecomposeOptions, Decomposer, Hull};

@@ -27,6 +27,7 @@ use crate::report::Report;
 use crate::scene::manifest::{InertialSpec, Manifest, ManifestObject, PoseSpec, Units};
 use crate::scene::UpAxis;
 use format::{f, vec3};
+use rayon::prelude::*;
 use serde::Serialize;
 use std::path::Path;
 
@@ -65,19 +66,43 @@ fn write_all(
     dir: &Path,
     templates: &Templates,
 ) -> Result<()> {
-    let mut ctx_bodies = Vec::new();
-    let mut body_files = Vec::new();
-    for b in &assembly.bodies {
-        let files = files::write_body_meshes(b, &dir.join("meshes"))?;
-        ctx_bodies.push(body_context(b, &files));
-        body_files.push(files);
-    }
-    usd::write_usd(assembly, &body_files, dir, templates, FLOOR_FRICTION)?;
+    // Each body's mesh files go to their own folder: written side by side, gathered in order
+    // (the first error in body order is the one reported, as when written one by one).
+    let meshes = dir.join("meshes");
+    let written: Vec<Result<files::BodyFiles>> = assembly
+        .bodies
+        .par_iter()
+        .map(|b| files::write_body_meshes(b, &meshes))
+        .collect();
+    let body_files = written.into_iter().collect::<Result<Vec<_>>>()?;
+    let ctx_bodies: Vec<BodyCtx> = assembly
+        .bodies
+        .iter()
+        .zip(&body_files)
+        .map(|(b, files)| body_context(b, files))
+        .collect();
+    // The USD files and the MJCF/URDF/JSON ones share nothing but their inputs.
+    let (usd, rest) = rayon::join(
+        || usd::write_usd(assembly, &body_files, dir, templates, FLOOR_FRICTION),
+        || write_mjcf_urdf_json(assembly, report, dir, templates, &ctx_bodies),
+    );
+    usd?;
+    rest
+}
+
+/// `scene.xml`, each body's `.xml` and `.urdf`, `scene.json` and `report.json`.
+fn write_mjcf_urdf_json(
+    assembly: &Assembly,
+    report: &Report,
+    dir: &Path,
+    templates: &Templates,
+    ctx_bodies: &[BodyCtx],
+) -> Result<()> {
     let keyframes = keyframes(assembly);
     let scene_ctx = minijinja::context! {
         generator => GENERATOR,
         scene => minijinja::context! { name => assembly.name.clone() },
-        bodies => ctx_bodies.clone(),
+        bodies => ctx_bodies.to_vec(),
         keyframes => keyframes,
         floor_friction => f(FLOOR_FRICTION),
     };
@@ -85,7 +110,7 @@ fn write_all(
         &dir.join("scene.xml"),
         templates.render("scene.xml.j2", scene_ctx)?.as_bytes(),
     )?;
-    for b in &ctx_bodies {
+    for b in ctx_bodies {
         let ctx = minijinja::context! { generator => GENERATOR, b => b.clone() };
         crate::fsutil::write(
             &dir.join(format!("{}.xml", b.name)),

@@ -20,6 +20,7 @@ use crate::body::{Assembly, Body};
 use crate::error::Result;
 use crate::mesh::{P3, V3};
 use nalgebra::{Matrix3, Rotation3, UnitQuaternion, Vector3};
+use rayon::prelude::*;
 use serde::Serialize;
 use std::fmt::Write as _;
 use std::path::Path;
@@ -75,22 +76,33 @@ pub fn write_usd(
     floor_friction: f64,
 ) -> Result<()> {
     let prims = prim_names(a.bodies.iter().map(|b| b.name.as_str()));
-    let mut objects = Vec::with_capacity(a.bodies.len());
-    for ((b, fl), prim) in a.bodies.iter().zip(files).zip(prims) {
-        let ctx = object_context(b, fl, prim);
-        let text = templates.render(
-            "object.usda.j2",
-            minijinja::context! { generator => GENERATOR, b => ctx.clone(), hull_scale => hull_scale() },
-        )?;
-        crate::fsutil::write(&dir.join(&ctx.file), text.as_bytes())?;
-        // The scene needs no mesh data.
-        objects.push(ObjectCtx {
-            materials: Vec::new(),
-            visuals: Vec::new(),
-            hulls: Vec::new(),
-            ..ctx
-        });
-    }
+    // One file per body, written side by side; the first error in body order is reported.
+    let jobs: Vec<(&Body, &BodyFiles, String)> = a
+        .bodies
+        .iter()
+        .zip(files)
+        .zip(prims)
+        .map(|((b, fl), prim)| (b, fl, prim))
+        .collect();
+    let written: Vec<Result<ObjectCtx>> = jobs
+        .into_par_iter()
+        .map(|(b, fl, prim)| {
+            let ctx = object_context(b, fl, prim);
+            let text = templates.render(
+                "object.usda.j2",
+                minijinja::context! { generator => GENERATOR, b => ctx.clone(), hull_scale => hull_scale() },
+            )?;
+            crate::fsutil::write(&dir.join(&ctx.file), text.as_bytes())?;
+            // The scene needs no mesh data.
+            Ok(ObjectCtx {
+                materials: Vec::new(),
+                visuals: Vec::new(),
+                hulls: Vec::new(),
+                ..ctx
+            })
+        })
+        .collect();
+    let objects = written.into_iter().collect::<Result<Vec<_>>>()?;
     let text = templates.render(
         "scene.usda.j2",
         minijinja::context! {

@@ -22,7 +22,7 @@ pub mod finding;
 
 use crate::body::Assembly;
 use crate::error::{Error, Result};
-use crate::metrics::{scene_metrics, MetricsOptions, PairMetrics, Solid};
+use crate::metrics::{scene_metrics, MetricsOptions, PairMetrics, ScenePair, Solid};
 use crate::physics::{settle, SettleOptions, SettleReport, SimBody};
 use serde::Serialize;
 
@@ -107,31 +107,49 @@ pub fn sim_bodies(a: &Assembly) -> Vec<SimBody> {
         .collect()
 }
 
+/// The Interact3D metrics of every pair, on the collision hulls and (with `visual_metrics`) on
+/// the visual meshes, world frame at the composed pose; the two sets side by side.
+fn static_metrics(
+    a: &Assembly,
+    opts: &ValidateOptions,
+) -> (Vec<ScenePair>, Option<Vec<ScenePair>>) {
+    rayon::join(
+        || {
+            let world_hulls: Vec<Vec<crate::mesh::Mesh>> = a
+                .bodies
+                .iter()
+                .map(|b| b.world_hulls().iter().map(|h| h.mesh()).collect())
+                .collect();
+            scene_metrics(
+                &world_hulls
+                    .iter()
+                    .map(|h| Solid::Hulls(h))
+                    .collect::<Vec<_>>(),
+                &opts.metrics,
+            )
+        },
+        || {
+            opts.visual_metrics.then(|| {
+                let world: Vec<crate::mesh::Mesh> =
+                    a.bodies.iter().map(|b| b.world_geometry()).collect();
+                scene_metrics(
+                    &world.iter().map(Solid::Mesh).collect::<Vec<_>>(),
+                    &opts.metrics,
+                )
+            })
+        },
+    )
+}
+
 /// Run every check on an assembly.
 pub fn validate(a: &Assembly, opts: &ValidateOptions) -> Result<Validation> {
     let mut warnings = Vec::new();
-    // Static metrics, world frame at the composed pose.
-    let world_hulls: Vec<Vec<crate::mesh::Mesh>> = a
-        .bodies
-        .iter()
-        .map(|b| b.world_hulls().iter().map(|h| h.mesh()).collect())
-        .collect();
-    let collision = scene_metrics(
-        &world_hulls
-            .iter()
-            .map(|h| Solid::Hulls(h))
-            .collect::<Vec<_>>(),
-        &opts.metrics,
-    );
-    let visual = if opts.visual_metrics {
-        let world: Vec<crate::mesh::Mesh> = a.bodies.iter().map(|b| b.world_geometry()).collect();
-        Some(scene_metrics(
-            &world.iter().map(Solid::Mesh).collect::<Vec<_>>(),
-            &opts.metrics,
-        ))
-    } else {
-        None
-    };
+    // The static metrics and the settle are independent computations on the same bodies: run
+    // side by side (the settle is one serial Rapier world; the metrics spread over the rest of
+    // the pool). Each gives the bits it gives alone.
+    let sims = sim_bodies(a);
+    let ((collision, visual), settled) =
+        rayon::join(|| static_metrics(a, opts), || settle(&sims, &opts.settle));
     let mut checks = Vec::new();
     let mut pairs = Vec::new();
     for (k, c) in collision.iter().enumerate() {
@@ -175,7 +193,7 @@ pub fn validate(a: &Assembly, opts: &ValidateOptions) -> Result<Validation> {
         });
     }
     // Dynamics.
-    let settle = settle(&sim_bodies(a), &opts.settle).map_err(|e| Error::Input {
+    let settle = settled.map_err(|e| Error::Input {
         path: a.name.clone().into(),
         message: format!("cannot simulate: {e}"),
     })?;
