@@ -219,6 +219,21 @@ pub fn surface_fit(
     d.iter().sum::<f64>() / guidance.len().max(1) as f64
 }
 
+/// A point's distance to the object's surface near its nearest object point `j` (object
+/// units): the signed distance along `j`'s normal and `true` when the point lies within two
+/// spacings of `j`'s tangent plane's foot, else the distance to `j` itself and `false`; `None`
+/// for an empty tree. Shared by [`surface_distances`] and [`offset_distances`].
+fn plane_distance(object: &Cloud, tree: &KdTree, spacing: f64, x: &P3) -> Option<(f64, bool)> {
+    let (j, d2) = tree.nearest(x)?;
+    let along = (x - object.points[j]).dot(&object.normals[j]);
+    let tangential = (d2 - along * along).max(0.0).sqrt();
+    Some(if tangential < 2.0 * spacing {
+        (along, true)
+    } else {
+        (d2.sqrt(), false)
+    })
+}
+
 /// The truncated distances [`surface_fit`] averages, one per guidance point.
 pub fn surface_distances(
     object: &Cloud,
@@ -234,18 +249,9 @@ pub fn surface_distances(
     guidance
         .iter()
         .map(|q| {
-            let x = inv.transform_point(q);
-            let d = match tree.nearest(&x) {
-                Some((j, d2)) => {
-                    let along = (x - object.points[j]).dot(&object.normals[j]);
-                    let tangential = (d2 - along * along).max(0.0).sqrt();
-                    t.scale
-                        * if tangential < 2.0 * spacing {
-                            along.abs()
-                        } else {
-                            d2.sqrt()
-                        }
-                }
+            let d = match plane_distance(object, tree, spacing, &inv.transform_point(q)) {
+                Some((v, true)) => t.scale * v.abs(),
+                Some((v, false)) => t.scale * v,
                 None => cap,
             };
             d.min(cap)
@@ -288,21 +294,12 @@ pub fn offset_distances(
     // (distance, signed along the normal?) per point.
     let d: Vec<(f64, bool)> = guidance
         .iter()
-        .map(|q| {
-            let x = inv.transform_point(q);
-            match tree.nearest(&x) {
-                Some((j, d2)) => {
-                    let along = (x - object.points[j]).dot(&object.normals[j]);
-                    let tangential = (d2 - along * along).max(0.0).sqrt();
-                    if tangential < 2.0 * spacing {
-                        (t.scale * along, true)
-                    } else {
-                        (t.scale * d2.sqrt(), false)
-                    }
-                }
+        .map(
+            |q| match plane_distance(object, tree, spacing, &inv.transform_point(q)) {
+                Some((v, plane)) => (t.scale * v, plane),
                 None => (cap, false),
-            }
-        })
+            },
+        )
         .collect();
     let mut signed: Vec<f64> = d
         .iter()
