@@ -518,11 +518,7 @@ mod tests {
         );
         let field = AnchorField::new(&[slab], 32);
         let ball = crate::shapes::uv_sphere(0.5, 48, 96);
-        let vis = crate::shapes::visual(
-            &ball,
-            crate::shapes::UvProjection::Box { tile: 1.0 },
-            Default::default(),
-        );
+        let vis = crate::shapes::plain_visual(&ball);
         let rotation = UnitQuaternion::from_euler_angles(0.3, 0.2, 0.1);
         let lowest = ball
             .vertices
@@ -565,11 +561,7 @@ mod tests {
         );
         let field = AnchorField::new(&[slab], 32);
         let item = crate::shapes::cuboid(V3::new(0.4, 0.3, 0.2));
-        let vis = crate::shapes::visual(
-            &item,
-            crate::shapes::UvProjection::Box { tile: 1.0 },
-            Default::default(),
-        );
+        let vis = crate::shapes::plain_visual(&item);
         let obj = Cloud::sample(&vis, 4000, 1);
         let tree = KdTree::new(&obj.points);
         // Truth: scale 1.5, a yaw, resting on the slab (the box's bottom at y = 0).

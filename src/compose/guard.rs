@@ -224,11 +224,7 @@ mod tests {
     #[test]
     fn guard_never_returns_a_worse_fit_when_refinement_diverges() {
         let mesh = crate::shapes::cuboid(V3::new(1.0, 0.6, 0.3));
-        let vis = crate::shapes::visual(
-            &mesh,
-            crate::shapes::UvProjection::Box { tile: 1.0 },
-            Default::default(),
-        );
+        let vis = crate::shapes::plain_visual(&mesh);
         let obj = Cloud::sample(&vis, 4000, 1);
         let tree = KdTree::new(&obj.points);
         let truth = Similarity {

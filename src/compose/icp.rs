@@ -211,11 +211,7 @@ mod tests {
     fn icp_converges_from_a_nearby_start_with_outliers() {
         let mut rng = Rng::new(11);
         let mesh = crate::shapes::cuboid(V3::new(1.0, 0.6, 0.3));
-        let vis = crate::shapes::visual(
-            &mesh,
-            crate::shapes::UvProjection::Box { tile: 1.0 },
-            Default::default(),
-        );
+        let vis = crate::shapes::plain_visual(&mesh);
         let obj = crate::compose::cloud::Cloud::sample(&vis, 4000, 1);
         let truth = Similarity {
             scale: 2.0,

@@ -121,11 +121,7 @@ mod tests {
     #[test]
     fn extents_of_a_rotated_box() {
         let mesh = crate::shapes::cuboid(V3::new(0.4, 1.0, 0.2));
-        let visual = crate::shapes::visual(
-            &mesh,
-            crate::shapes::UvProjection::Box { tile: 1.0 },
-            Default::default(),
-        );
+        let visual = crate::shapes::plain_visual(&mesh);
         let q = UnitQuaternion::from_euler_angles(0.4, -0.9, 1.7);
         let mut m: Matrix4<f64> = q.to_homogeneous();
         m[(0, 3)] = 3.0;

@@ -400,11 +400,7 @@ mod tests {
     use crate::rng::Rng;
 
     fn sampled(mesh: &crate::mesh::Mesh, n: usize) -> Cloud {
-        let vis = crate::shapes::visual(
-            mesh,
-            crate::shapes::UvProjection::Box { tile: 1.0 },
-            Default::default(),
-        );
+        let vis = crate::shapes::plain_visual(mesh);
         Cloud::sample(&vis, n, 3)
     }
 

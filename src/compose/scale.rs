@@ -96,11 +96,7 @@ mod tests {
         // A 1 × 0.6 × 0.03 board; its guidance is the board at scale 2 with a hole in the middle
         // and half the points of a ragged strip along one long rim missing.
         let mesh = crate::shapes::cuboid(V3::new(1.0, 0.6, 0.03));
-        let vis = crate::shapes::visual(
-            &mesh,
-            crate::shapes::UvProjection::Box { tile: 1.0 },
-            Default::default(),
-        );
+        let vis = crate::shapes::plain_visual(&mesh);
         let object = Cloud::sample(&vis, 5000, 1);
         let truth = Similarity {
             scale: 2.0,

@@ -149,11 +149,7 @@ mod tests {
     fn finds_the_scale_of_a_stepped_bar_from_a_fattened_strip() {
         let profile = [[0.06, -0.5], [0.06, -0.15], [0.02, -0.15], [0.02, 0.5]];
         let mesh = crate::shapes::revolve(&profile, 32);
-        let vis = crate::shapes::visual(
-            &mesh,
-            crate::shapes::UvProjection::Box { tile: 1.0 },
-            Default::default(),
-        );
+        let vis = crate::shapes::plain_visual(&mesh);
         let object = Cloud::sample(&vis, 4000, 1);
         let tree = KdTree::new(&object.points);
         let truth = Similarity {

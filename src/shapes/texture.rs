@@ -128,6 +128,12 @@ pub fn with_uvs(mesh: &Mesh, projection: UvProjection) -> (Vec<P3>, Vec<[f64; 2]
     (positions, uvs, triangles)
 }
 
+/// [`visual`] with box-projected UVs (tile 1) and the default material: an untextured object,
+/// as the registration tests sample it.
+pub fn plain_visual(mesh: &Mesh) -> VisualMesh {
+    visual(mesh, UvProjection::Box { tile: 1.0 }, Material::default())
+}
+
 /// A one-part [`VisualMesh`] of `mesh` with UVs by `projection` and `material`.
 pub fn visual(mesh: &Mesh, projection: UvProjection, material: Material) -> VisualMesh {
     let (positions, uvs, triangles) = with_uvs(mesh, projection);
