@@ -400,7 +400,9 @@ pub struct ContactReport {
     /// The candidate's scale over the registered one.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub scale_ratio: Option<f64>,
-    /// The guard's allowance (the guidance's noise) and the smallest visible span.
+    /// The guidance's noise (the robust σ of its residuals at the registered pose: the noise
+    /// gate's unit and, for a candidate, the guard's allowance) and the smallest visible span.
+    /// Reported on a skip too, so the report shows how far the gates were from passing.
     pub noise: f64,
     pub coverage: f64,
     pub taken: bool,
@@ -448,22 +450,25 @@ pub fn run<'a>(
                 taken,
             }
         }
-        Err(e) => ContactReport {
-            skipped: Some(match e {
-                Skip::ScaleObserved => "scale_observed",
-                Skip::InContact => "in_contact",
-                Skip::NotBelow => "not_below",
-                Skip::TooFar => "too_far",
-                Skip::NoLever => "no_lever",
-                Skip::Penetrating => "penetrating",
-            }),
-            gap_before: gaps.gap(&start, field).value,
-            gap_after: None,
-            scale_ratio: None,
-            noise: 0.0,
-            coverage: 0.0,
-            taken: false,
-        },
+        Err(e) => {
+            let (_, noise, coverage) = visible(object, tree, &g_icp, &start);
+            ContactReport {
+                skipped: Some(match e {
+                    Skip::ScaleObserved => "scale_observed",
+                    Skip::InContact => "in_contact",
+                    Skip::NotBelow => "not_below",
+                    Skip::TooFar => "too_far",
+                    Skip::NoLever => "no_lever",
+                    Skip::Penetrating => "penetrating",
+                }),
+                gap_before: gaps.gap(&start, field).value,
+                gap_after: None,
+                scale_ratio: None,
+                noise,
+                coverage,
+                taken: false,
+            }
+        }
     };
     (guard, report)
 }
@@ -541,6 +546,49 @@ mod tests {
             "coarse {plain}, probe {fine}"
         );
         assert!(probe.gap(&t, &field).normal.y > 0.99);
+    }
+
+    /// A box resting on a slab at its true pose, its whole surface as guidance with Gaussian
+    /// noise of σ = 0.004 along the normals: the stage must skip it as in contact, and its report
+    /// must carry the guidance's noise (robust σ of the residuals: σ for Gaussian noise, within
+    /// 10 %) and a whole visible part (coverage near 1), not zeros.
+    #[test]
+    fn a_skip_reports_the_guidance_noise() {
+        let slab: Mesh = crate::shapes::cuboid(V3::new(2.0, 0.2, 2.0)).transformed(
+            &Similarity {
+                translation: V3::new(0.0, -0.1, 0.0),
+                ..Similarity::identity()
+            }
+            .matrix(),
+        );
+        let field = AnchorField::new(&[slab], 32);
+        let vis = crate::shapes::plain_visual(&crate::shapes::cuboid(V3::new(0.4, 0.3, 0.2)));
+        let obj = Cloud::sample(&vis, 4000, 1);
+        let tree = KdTree::new(&obj.points);
+        // Resting on the slab: the box's bottom at y = 0.
+        let truth = Similarity {
+            scale: 1.0,
+            rotation: UnitQuaternion::from_euler_angles(0.0, 0.7, 0.0),
+            translation: V3::new(0.1, 0.15, -0.2),
+        };
+        let sigma = 0.004;
+        let mut g = Cloud::sample(&vis, 3000, 2).transformed(&truth.matrix());
+        let mut rng = crate::rng::Rng::new(5);
+        for (p, n) in g.points.iter_mut().zip(&g.normals) {
+            *p += n * (sigma * rng.normal());
+        }
+        let dense = Cloud::sample(&vis, 20_000, 3).points;
+        let probe = g.subsample(1000).points;
+        let o = ContactOptions::grow();
+        let sp = spacing(&vis, 4000);
+        let (guard, r) = run(
+            &obj, &tree, sp, &g, &dense, probe, truth, "s", &field, None, &o,
+        );
+        assert_eq!(r.skipped, Some("in_contact"));
+        assert!(!r.taken);
+        assert_eq!(guard.stage(), "s");
+        assert!((r.noise / sigma - 1.0).abs() < 0.1, "noise {}", r.noise);
+        assert!(r.coverage > 0.9, "coverage {}", r.coverage);
     }
 
     /// A box resting on a slab; the guidance shows only the box's top half, and the start pose
