@@ -251,6 +251,7 @@ fn set(o: &mut SettleOptions, kv: &str) {
         "loaded_solver_iterations" => o.loaded_solver_iterations = x as usize,
         "loaded_pgs_iterations" => o.loaded_pgs_iterations = x as usize,
         "loaded_fresh_contacts" => o.loaded_fresh_contacts = x != 0.0,
+        "loaded_stiff_contacts" => o.loaded_stiff_contacts = x != 0.0,
         "stabilization_iterations" => o.stabilization_iterations = x as usize,
         "settle_max_time" => o.settle_max_time = x,
         "rest_time" => o.rest_time = x,

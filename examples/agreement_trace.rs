@@ -32,6 +32,7 @@ fn main() {
                 "loaded_solver_iterations" => opts.loaded_solver_iterations = x as usize,
                 "loaded_pgs_iterations" => opts.loaded_pgs_iterations = x as usize,
                 "loaded_fresh_contacts" => opts.loaded_fresh_contacts = x != 0.0,
+                "loaded_stiff_contacts" => opts.loaded_stiff_contacts = x != 0.0,
                 "coulomb_friction" => opts.coulomb_friction = x != 0.0,
                 "contact_clustering" => opts.contact_clustering = x != 0.0,
                 "friction_in_bias_pass" => opts.friction_in_bias_pass = x != 0.0,

@@ -23,8 +23,11 @@
 //! held the mug upright; with fresh contacts Rapier topples the mug (83° / 84°) as MuJoCo does
 //! (82°) from the composed pose.
 //!
+//! With [`SettleOptions::loaded_stiff_contacts`] a world with a loaded body also runs its contacts
+//! stiffer by the substep ratio (off by default; issue #33, "Tenth stop").
+//!
 //! Entry points: [`heavily_loaded`] (which bodies), [`Sim::load_extra_iterations`] (apply:
-//! iterations and fresh contacts).
+//! iterations, fresh contacts, stiff contacts).
 
 use super::world::Sim;
 use super::*;
@@ -64,6 +67,14 @@ impl Sim<'_> {
             .loaded_pgs_iterations
             .saturating_sub(self.opts.pgs_iterations);
         let fresh = self.opts.loaded_fresh_contacts && self.opts.contact_recycling;
+        if self.opts.loaded_stiff_contacts && extra_sub > 0 && loaded.iter().any(|&l| l) {
+            // Rapier's contact softness is the world's, not a body's: the whole world runs
+            // stiffer. `hω` stays the unloaded world's in the loaded islands' substeps.
+            let k = self.opts.loaded_solver_iterations as f64 / self.opts.solver_iterations as f64;
+            let ip = &mut self.world.integration_parameters;
+            ip.contact_softness.natural_frequency = self.opts.contact_frequency * k;
+            ip.static_contact_softness.natural_frequency = self.opts.static_contact_frequency * k;
+        }
         for (i, _) in loaded.iter().enumerate().filter(|(_, &l)| l) {
             let rb = &mut self.world.bodies[self.handles[i]];
             rb.set_additional_solver_iterations(extra_sub);
@@ -85,6 +96,7 @@ mod tests {
     use super::*;
     use crate::mesh::V3;
     use crate::shapes::cuboid;
+    use std::f64::consts::PI;
 
     /// A box of extents `e` and `mass` standing with its bottom face at height `bottom`.
     fn block(name: &str, e: [f64; 3], mass: f64, x: f64, bottom: f64, fixed: bool) -> SimBody {
@@ -211,6 +223,65 @@ mod tests {
         assert_eq!(
             settle(&plain, &opts).unwrap(),
             settle(&plain, &recycled).unwrap()
+        );
+    }
+
+    #[test]
+    fn stiff_loaded_contacts_sink_the_load_by_the_square_of_the_substep_ratio_less() {
+        // The 25x stack alone: a 0.5 kg brick on a 20 g dice on the floor. Rapier's contact is
+        // a spring normalised by the effective mass of the constraint, so the brick-dice
+        // contact (load m_b g, reduced mass m_b m_d / (m_b + m_d), the four corner points
+        // sharing it symmetrically) rests at about a = g (1 + m_b / m_d) = 26 g over
+        // 2 omega^2: 0.224 mm at 120 Hz, and 1/4 of it at 240 Hz (the substep ratio 8 / 4 = 2,
+        // squared).
+        let pair: Vec<SimBody> = stacks()
+            .into_iter()
+            .filter(|b| ["dice", "brick"].contains(&b.name.as_str()))
+            .collect();
+        let depth = |stiff: bool| {
+            let opts = SettleOptions {
+                loaded_stiff_contacts: stiff,
+                ..SettleOptions::default()
+            };
+            let r = settle(&pair, &opts).unwrap();
+            assert_eq!(r.heavily_loaded, ["dice"]);
+            assert!(r.passed);
+            let dice = r.bodies.iter().find(|b| b.name == "dice").unwrap();
+            assert_eq!(dice.rest_max_penetration_with.as_deref(), Some("brick"));
+            dice.rest_max_penetration
+        };
+        let spring = |hz: f64| 9.81 * (1.0 + 0.5 / 0.02) / (2.0 * (2.0 * PI * hz).powi(2));
+        let (soft, stiff) = (depth(false), depth(true));
+        eprintln!(
+            "soft {soft:.3e} (spring {:.3e}), stiff {stiff:.3e} (spring {:.3e}), ratio {:.3}",
+            spring(120.0),
+            spring(240.0),
+            stiff / soft
+        );
+        // The depth goes as 1/omega^2 at a fixed substep: a quarter (measured 0.249).
+        assert!((0.22..0.28).contains(&(stiff / soft)), "{stiff} / {soft}");
+        // The single-spring estimate gives the order of magnitude only: measured 1.96x of it
+        // (the four coupled corner constraints and the floor contact under the dice settle
+        // deeper than one spring; not derived here).
+        for (d, hz) in [(soft, 120.0), (stiff, 240.0)] {
+            assert!(
+                (1.0..3.0).contains(&(d / spring(hz))),
+                "{d} vs {}",
+                spring(hz)
+            );
+        }
+        // Without a loaded body the option changes nothing, bit for bit.
+        let plain: Vec<SimBody> = stacks()
+            .into_iter()
+            .filter(|b| ["anvil", "feather", "pad", "weight"].contains(&b.name.as_str()))
+            .collect();
+        let stiff_opts = SettleOptions {
+            loaded_stiff_contacts: true,
+            ..SettleOptions::default()
+        };
+        assert_eq!(
+            settle(&plain, &SettleOptions::default()).unwrap(),
+            settle(&plain, &stiff_opts).unwrap()
         );
     }
 }
