@@ -238,8 +238,7 @@ pub fn validate(a: &Assembly, opts: &ValidateOptions) -> Result<Validation> {
     })?;
     checks.extend(dynamic_checks(&settle, &opts.settle));
     warnings.extend(settle.warnings.iter().cloned());
-    let mut passed = checks.iter().all(|c| c.passed) && settle.passed;
-    let mut verdict = if passed { Verdict::Pass } else { Verdict::Fail };
+    let unnudged = checks.iter().all(|c| c.passed) && settle.passed;
     // The nudge check only asks about the settle: a scene failing a static check fails anyway.
     let statics_pass = checks
         .iter()
@@ -259,24 +258,8 @@ pub fn validate(a: &Assembly, opts: &ValidateOptions) -> Result<Validation> {
             verdicts,
         }
     });
-    if let Some(n) = nudged.as_ref().filter(|n| n.undetermined(passed)) {
-        verdict = Verdict::Undetermined;
-        warnings.push(format!(
-            "undetermined verdict: {} of {} starts nudged by {} mm / {}° pass (unnudged: {}); {}",
-            n.passed,
-            n.runs,
-            nudge::NUDGE_M * 1e3,
-            nudge::NUDGE_DEG,
-            if passed { "pass" } else { "fail" },
-            match opts.undetermined {
-                Undetermined::Fail => "failed (--undetermined fail)",
-                Undetermined::Warn => "the unnudged verdict stands (--undetermined warn)",
-            }
-        ));
-        if opts.undetermined == Undetermined::Fail {
-            passed = false;
-        }
-    }
+    let (passed, verdict, warning) = nudge::gate(unnudged, nudged.as_ref(), opts.undetermined);
+    warnings.extend(warning);
     Ok(Validation {
         passed,
         verdict,

@@ -11,8 +11,9 @@
 //! nudged starts that pass ([`NudgeReport`]). What a gate does with it is
 //! [`ValidateOptions::undetermined`](super::ValidateOptions::undetermined).
 //!
-//! Entry points: [`nudged_poses`], [`signals`], [`nudged_verdicts`], [`NudgeOptions`].
+//! Entry points: [`nudged_poses`], [`signals`], [`nudged_verdicts`], [`gate`], [`NudgeOptions`].
 
+use super::{Undetermined, Verdict};
 use crate::physics::{settle, SettleOptions, SettleReport, SimBody};
 use nalgebra::{Isometry3, Point3, Translation3, Unit, UnitQuaternion, Vector3};
 use serde::Serialize;
@@ -113,6 +114,37 @@ impl NudgeReport {
     /// The nudged verdicts split, or all disagree with the unnudged one.
     pub fn undetermined(&self, unnudged: bool) -> bool {
         self.verdicts.iter().any(|&v| v != unnudged)
+    }
+}
+
+/// The gate: the unnudged verdict `passed`, the nudge check (when it ran) and the policy give
+/// (passed, verdict, the warning to add). Undetermined when some nudged start's verdict differs
+/// from the unnudged one; [`Undetermined::Fail`] then fails the scene.
+pub fn gate(
+    passed: bool,
+    nudge: Option<&NudgeReport>,
+    policy: Undetermined,
+) -> (bool, Verdict, Option<String>) {
+    match nudge.filter(|n| n.undetermined(passed)) {
+        None => (
+            passed,
+            if passed { Verdict::Pass } else { Verdict::Fail },
+            None,
+        ),
+        Some(n) => (
+            passed && policy == Undetermined::Warn,
+            Verdict::Undetermined,
+            Some(format!(
+                "undetermined verdict: {} of {} nudged starts pass (unnudged: {}); {}",
+                n.passed,
+                n.runs,
+                if passed { "pass" } else { "fail" },
+                match policy {
+                    Undetermined::Fail => "failed (--undetermined fail)",
+                    Undetermined::Warn => "the unnudged verdict stands (--undetermined warn)",
+                }
+            )),
+        ),
     }
 }
 
@@ -273,5 +305,19 @@ mod tests {
             "no split near {star}: {split:?}"
         );
         assert!(split.iter().all(|t| (t - star).abs() <= 3.0), "{split:?}");
+        // The gate on those verdicts: at 8° the scene passes, determined, under either policy;
+        // at a split angle it is undetermined, passes with `warn` and fails with `fail`.
+        let at8 = report(run(8.0));
+        for policy in [Undetermined::Warn, Undetermined::Fail] {
+            assert_eq!(gate(true, Some(&at8), policy), (true, Verdict::Pass, None));
+        }
+        let near = report(run(split[0]));
+        let (warned, v, why) = gate(true, Some(&near), Undetermined::Warn);
+        assert!(warned && v == Verdict::Undetermined, "{why:?}");
+        let (failed, v, _) = gate(true, Some(&near), Undetermined::Fail);
+        assert!(!failed && v == Verdict::Undetermined);
+        // A failing scene stays failed whatever its nudged starts say.
+        assert!(!gate(false, Some(&near), Undetermined::Warn).0);
+        assert_eq!(gate(false, None, Undetermined::Warn).1, Verdict::Fail);
     }
 }
