@@ -328,6 +328,14 @@ fn print_table(engine: &str, seeds: &std::ops::Range<u64>, s: &Summary) {
         pct(s.verdict_agree, s.scenes)
     );
     println!(
+        "{:<44} {:>8}  ({:.1} % of {} determined; {} undetermined)",
+        "verdict agrees on determined scenes",
+        s.determined_agree,
+        pct(s.determined_agree, s.scenes - s.undetermined),
+        s.scenes - s.undetermined,
+        s.undetermined
+    );
+    println!(
         "{:<44} {:>8}  ({:.1} % of {} we pass)",
         "rest agrees (<= 1 mm, <= 1 deg for 2 s)",
         s.rest_agree,

@@ -221,6 +221,11 @@ pub struct Summary {
     pub we_pass: usize,
     pub mujoco_pass: usize,
     pub verdict_agree: usize,
+    /// Scenes whose verdict is undetermined (our run-time nudge check split; they stay in
+    /// `scenes` and `verdict_agree` with their gate verdict, `passed`).
+    pub undetermined: usize,
+    /// Of the other (determined) scenes, those whose verdict agrees.
+    pub determined_agree: usize,
     pub rest_judged: usize,
     pub rest_agree: usize,
     pub marginal: usize,
@@ -298,6 +303,11 @@ pub fn summary(js: &[Judged]) -> Summary {
         s.we_pass += j.ours.passed as usize;
         s.mujoco_pass += j.mujoco.passed as usize;
         s.verdict_agree += j.verdict_agrees as usize;
+        if j.ours.verdict == crate::validate::Verdict::Undetermined {
+            s.undetermined += 1;
+        } else {
+            s.determined_agree += j.verdict_agrees as usize;
+        }
         s.marginal += j.marginal as usize;
         if let Some(a) = j.rest_agrees {
             s.rest_judged += 1;

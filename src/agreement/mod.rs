@@ -266,6 +266,11 @@ pub fn diagonal(b: &Body) -> f64 {
 #[derive(Clone, Debug, Serialize)]
 pub struct Ours {
     pub passed: bool,
+    /// `pass`, `fail`, or `undetermined` (the run-time nudge check's verdicts split).
+    pub verdict: crate::validate::Verdict,
+    /// The run-time nudge check, when it ran: (starts that passed, starts).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub nudged: Option<(usize, usize)>,
     /// Failed checks and body reasons, when it failed.
     pub reasons: Vec<String>,
     /// Wall time of the validation (s).
@@ -333,6 +338,7 @@ pub fn run_scene_with(
     for b in &v.settle.bodies {
         reasons.extend(b.reasons.iter().map(|r| format!("{}: {r}", b.name)));
     }
+    let nudged = v.nudge.as_ref().map(|n| (n.passed, n.runs));
     let bodies = a
         .bodies
         .iter()
@@ -350,6 +356,8 @@ pub fn run_scene_with(
         .collect();
     Ok(Ours {
         passed: v.passed,
+        verdict: v.verdict,
+        nudged,
         reasons,
         seconds,
         bodies,

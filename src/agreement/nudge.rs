@@ -13,13 +13,9 @@
 
 use super::Generated;
 use crate::error::Result;
-use nalgebra::{Isometry3, Point3, Translation3, Unit, UnitQuaternion, Vector3};
 use serde::Serialize;
 
-/// The shift of a nudge (m).
-pub const NUDGE_M: f64 = 5e-4;
-/// The turn of a nudge (degrees), about a horizontal axis through the body's centre of mass.
-pub const NUDGE_DEG: f64 = 0.5;
+pub use crate::validate::nudge::{nudged_poses, NUDGE_DEG, NUDGE_M};
 
 /// Our verdicts over the nudged starts of one scene.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize)]
@@ -46,66 +42,40 @@ impl Spread {
     }
 }
 
-/// The nudged starts: for each free body (`fixed[i]` false) in turn, its pose turned by
-/// [`NUDGE_DEG`] about ±x and ±y through its centre of mass `coms[i]` (body frame), then
-/// shifted by [`NUDGE_M`] along ±x and ±y; every other body keeps its pose. 8 starts a free
-/// body, in that order.
-pub fn nudged_poses(
-    poses: &[Isometry3<f64>],
-    coms: &[Point3<f64>],
-    fixed: &[bool],
-) -> Vec<Vec<Isometry3<f64>>> {
-    let axes = [Vector3::x(), -Vector3::x(), Vector3::y(), -Vector3::y()];
-    let mut out = Vec::new();
-    for i in (0..poses.len()).filter(|&i| !fixed[i]) {
-        let com = (poses[i] * coms[i]).coords;
-        for kind in 0..2 {
-            for axis in &axes {
-                let d = if kind == 0 {
-                    let r = UnitQuaternion::from_axis_angle(
-                        &Unit::new_normalize(*axis),
-                        NUDGE_DEG.to_radians(),
-                    );
-                    Isometry3::from_parts(Translation3::from(com), r)
-                        * Isometry3::translation(-com.x, -com.y, -com.z)
-                } else {
-                    Isometry3::from_parts(
-                        Translation3::from(axis * NUDGE_M),
-                        UnitQuaternion::identity(),
-                    )
-                };
-                let mut p = poses.to_vec();
-                p[i] = d * p[i];
-                out.push(p);
-            }
-        }
-    }
-    out
-}
-
 /// Our validator (as the agreement run uses it: `run_scene_with`'s options, no export) over
 /// every nudged start of a generated scene.
 pub fn spread(g: &Generated, settle: &crate::physics::SettleOptions) -> Result<Spread> {
+    let v = verdicts(g, settle)?;
+    Ok(Spread {
+        runs: v.len(),
+        passed: v.iter().filter(|&&p| p).count(),
+    })
+}
+
+/// Our validator's verdict from each nudged start of a generated scene, in
+/// [`nudged_poses`]' order.
+pub fn verdicts(g: &Generated, settle: &crate::physics::SettleOptions) -> Result<Vec<bool>> {
     let a = &g.assembly;
     let poses: Vec<_> = a.bodies.iter().map(|b| b.composed_pose).collect();
     let coms: Vec<_> = a.bodies.iter().map(|b| b.inertial.com).collect();
     let fixed: Vec<_> = a.bodies.iter().map(|b| b.fixed).collect();
-    let opts = crate::validate::ValidateOptions {
+    let mut opts = crate::validate::ValidateOptions {
         visual_metrics: false,
         settle: settle.clone(),
         ..Default::default()
     };
-    let mut s = Spread::default();
+    // Each start's own verdict, one settle each (no run-time nudge check inside a nudge).
+    opts.nudge.enabled = false;
+    let mut out = Vec::new();
     for p in nudged_poses(&poses, &coms, &fixed) {
         let mut n = a.clone();
         for (b, q) in n.bodies.iter_mut().zip(p) {
             b.pose = q;
             b.composed_pose = q;
         }
-        s.runs += 1;
-        s.passed += crate::validate::validate(&n, &opts)?.passed as usize;
+        out.push(crate::validate::validate(&n, &opts)?.passed);
     }
-    Ok(s)
+    Ok(out)
 }
 
 #[cfg(test)]
@@ -113,7 +83,7 @@ mod tests {
     use super::*;
     use crate::mesh::V3;
     use crate::physics::{settle, SettleOptions, SimBody};
-    use nalgebra::Matrix3;
+    use nalgebra::{Isometry3, Matrix3, Point3, Translation3, UnitQuaternion, Vector3};
 
     /// A cube of side `s` leaning at `theta` degrees on one bottom edge (the edge along y, on
     /// the floor, 0.5 mm above it).

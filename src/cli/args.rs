@@ -134,6 +134,14 @@ pub struct CheckArgs {
     /// Skip the metrics on the visual meshes (collision hulls are always checked).
     #[arg(long)]
     pub no_visual_metrics: bool,
+    /// What an undetermined scene does to the exit code (its verdict flips under a 0.5°
+    /// nudge of the composed pose): `warn` and keep the unnudged verdict, or `fail` it (a strict
+    /// gate; see docs/validation.md for what each costs).
+    #[arg(long, value_enum, default_value = "warn")]
+    pub undetermined: crate::validate::Undetermined,
+    /// Skip the run-time nudge check (the verdict is the one settle's: pass or fail).
+    #[arg(long)]
+    pub no_nudge_check: bool,
 }
 
 impl CheckArgs {
@@ -148,6 +156,8 @@ impl CheckArgs {
         o.settle.max_rest_penetration = self.max_rest_penetration;
         o.visual_metrics = !self.no_visual_metrics;
         o.max_visual_penetration = self.max_visual_penetration;
+        o.undetermined = self.undetermined;
+        o.nudge.enabled = !self.no_nudge_check;
         o
     }
 }

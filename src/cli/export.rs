@@ -65,7 +65,7 @@ pub fn export(a: ExportArgs) -> Result<ExitCode, Error> {
                     crate::validate::junit(&report.scene, v).as_bytes(),
                 )?;
             }
-            summary += if v.passed { "PASS" } else { "FAIL" };
+            summary += &crate::validate::verdict_line(v);
             if v.passed {
                 ExitCode::SUCCESS
             } else {

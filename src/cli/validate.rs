@@ -43,7 +43,7 @@ pub fn validate(a: ValidateArgs) -> Result<ExitCode, Error> {
                     "validated {} in {:.2} s: {}",
                     assembly.name,
                     t.elapsed().as_secs_f64(),
-                    if v.passed { "PASS" } else { "FAIL" }
+                    crate::validate::verdict_line(&v)
                 ),
             );
             if a.json {

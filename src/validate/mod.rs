@@ -6,6 +6,9 @@
 //!    `max_collision_penetration` (0.1 mm). Visual interpenetration is reported, and warned about.
 //! 2. **Dynamic**, in Rapier ([`crate::physics`]): settle from the composed pose (drift, turn, left
 //!    its support), then rest 1 s (motion, turn, contact penetration).
+//! 3. **Nudge check** ([`nudge`]), only where the one settle's drift or turn says the verdict
+//!    may be fragile: the firing bodies turned 0.5° four ways and settled again; split verdicts
+//!    make the scene [`Verdict::Undetermined`], gated by [`ValidateOptions::undetermined`].
 //!
 //! Every check is a [`Check`] with its value and limit, so a report, a table and JUnit XML all
 //! come from the same list.
@@ -19,6 +22,7 @@ pub mod asset;
 pub mod ci;
 pub mod contact;
 pub mod finding;
+pub mod nudge;
 
 use crate::body::Assembly;
 use crate::error::{Error, Result};
@@ -38,6 +42,31 @@ pub struct ValidateOptions {
     /// Largest penetration between the visual meshes of different objects (m). The scene-aware
     /// decomposition cuts hulls apart even where the meshes overlap, so the meshes are gated too.
     pub max_visual_penetration: f64,
+    /// The run-time nudge check: when one settle suggests its verdict may flip under a 0.5 mm /
+    /// 0.5° nudge, settle the nudged starts too ([`nudge`]).
+    pub nudge: nudge::NudgeOptions,
+    /// What an undetermined verdict does to `passed` (the exit code, and whether `export`
+    /// starts from the settled pose).
+    pub undetermined: Undetermined,
+}
+
+/// What a gate does with an undetermined scene (its nudged verdicts split).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, clap::ValueEnum)]
+#[serde(rename_all = "snake_case")]
+pub enum Undetermined {
+    /// It fails: a verdict a 0.5 mm / 0.5° nudge flips is not one to certify.
+    Fail,
+    /// It keeps the unnudged verdict, with a warning.
+    Warn,
+}
+
+/// A scene's verdict: `undetermined` when the nudged starts of the run-time nudge check split.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Verdict {
+    Pass,
+    Fail,
+    Undetermined,
 }
 
 impl Default for ValidateOptions {
@@ -48,6 +77,8 @@ impl Default for ValidateOptions {
             max_collision_penetration: 1e-4,
             visual_metrics: true,
             max_visual_penetration: 1e-4,
+            nudge: nudge::NudgeOptions::default(),
+            undetermined: Undetermined::Warn,
         }
     }
 }
@@ -81,7 +112,15 @@ pub struct Check {
 /// The validation of one scene.
 #[derive(Clone, Debug, Serialize)]
 pub struct Validation {
+    /// The gate: the checks of the one settle, and, for an undetermined scene, what
+    /// [`ValidateOptions::undetermined`] says.
     pub passed: bool,
+    /// `pass` or `fail` by the one settle's checks, `undetermined` when the run-time nudge check
+    /// ran and its verdicts split.
+    pub verdict: Verdict,
+    /// The run-time nudge check, when a signal fired.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub nudge: Option<nudge::NudgeReport>,
     pub checks: Vec<Check>,
     pub pairs: Vec<PairReport>,
     pub settle: SettleReport,
@@ -199,9 +238,32 @@ pub fn validate(a: &Assembly, opts: &ValidateOptions) -> Result<Validation> {
     })?;
     checks.extend(dynamic_checks(&settle, &opts.settle));
     warnings.extend(settle.warnings.iter().cloned());
-    let passed = checks.iter().all(|c| c.passed) && settle.passed;
+    let unnudged = checks.iter().all(|c| c.passed) && settle.passed;
+    // The nudge check only asks about the settle: a scene failing a static check fails anyway.
+    let statics_pass = checks
+        .iter()
+        .filter(|c| c.name.ends_with("_penetration"))
+        .all(|c| c.passed);
+    let signals = nudge::signals(&settle, &opts.settle, &opts.nudge);
+    let nudged = (opts.nudge.enabled && statics_pass && !signals.is_empty()).then(|| {
+        let mut which = vec![false; sims.len()];
+        for (i, _) in &signals {
+            which[*i] = true;
+        }
+        let verdicts = nudge::nudged_verdicts(&sims, &which, &opts.settle, opts.nudge.starts);
+        nudge::NudgeReport {
+            signals: signals.into_iter().map(|(_, why)| why).collect(),
+            runs: verdicts.len(),
+            passed: verdicts.iter().filter(|&&v| v).count(),
+            verdicts,
+        }
+    });
+    let (passed, verdict, warning) = nudge::gate(unnudged, nudged.as_ref(), opts.undetermined);
+    warnings.extend(warning);
     Ok(Validation {
         passed,
+        verdict,
+        nudge: nudged,
         checks,
         pairs,
         settle,
@@ -257,8 +319,21 @@ pub fn table(v: &Validation) -> String {
     for c in v.checks.iter().filter(|c| !c.passed) {
         s += &format!("  FAIL {} {}: {}\n", c.name, c.subject, c.message);
     }
-    s += &format!("verdict: {}\n", if v.passed { "PASS" } else { "FAIL" });
+    s += &format!("verdict: {}\n", verdict_line(v));
     s
+}
+
+/// The verdict in words: `PASS`, `FAIL`, or `UNDETERMINED (k of n nudged starts pass): PASS|FAIL`
+/// (the gate's outcome after [`ValidateOptions::undetermined`]).
+pub fn verdict_line(v: &Validation) -> String {
+    let gate = if v.passed { "PASS" } else { "FAIL" };
+    match (&v.verdict, &v.nudge) {
+        (Verdict::Undetermined, Some(n)) => format!(
+            "UNDETERMINED ({} of {} nudged starts pass): {gate}",
+            n.passed, n.runs
+        ),
+        _ => gate.into(),
+    }
 }
 
 /// JUnit XML, one test case per check (for CI systems).
