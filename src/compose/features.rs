@@ -158,6 +158,10 @@ fn fdist(a: &[f32; DIM], b: &[f32; DIM]) -> f32 {
     a.iter().zip(b).map(|(x, y)| (x - y) * (x - y)).sum()
 }
 
+/// One chunk of rows of the matching: each row's nearest column, and each column's (least
+/// distance, row) over the chunk's rows.
+type Chunk = (Vec<usize>, Vec<(f32, usize)>);
+
 /// Putative correspondences (index in `a`, index in `b`): each point's nearest descriptor in
 /// the other set, both directions, mutual matches first, deterministic order.
 pub fn match_features(a: &Features, b: &Features) -> Vec<(usize, usize)> {
@@ -170,7 +174,7 @@ pub fn match_features(a: &Features, b: &Features) -> Vec<(usize, usize)> {
     // later chunk takes a column only with a strictly smaller distance, so the merge keeps the
     // lowest index of a tie.
     let chunk = 64;
-    let parts: Vec<(Vec<usize>, Vec<(f32, usize)>)> = a
+    let parts: Vec<Chunk> = a
         .descriptors
         .par_chunks(chunk)
         .enumerate()
