@@ -166,6 +166,9 @@ pub fn run(args: &[String]) {
         .map(|s| s.split(',').map(str::to_string).collect())
         .unwrap_or_default();
     let verbose = args.iter().any(|a| a == "-v");
+    // `--dump`: each object's pose and stage fits at full precision (stderr), so two builds
+    // can be diffed for the same results (a cost-only change must print the same lines).
+    let dump = args.iter().any(|a| a == "--dump");
     // The contact-scale stage: `grow` (default, as `compose`: ungated, floating items only),
     // `off`, `on` (gated) or `ungated` (no coverage gate: the gap, the lever and the guard
     // decide).
@@ -269,6 +272,9 @@ pub fn run(args: &[String]) {
                     // On one thread the CPU time of the pool's thread is the pair's cost on one
                     // core, whatever else the machine runs; on more, the wall time.
                     let secs = if threads <= 1 { cpu } else { wall };
+                    if dump {
+                        eprintln!("TIME pair {k} seed {seed}: {secs:.3} s");
+                    }
                     let mut recs = Vec::new();
                     let mut placed = Vec::new();
                     let mut truth_placed = Vec::new();
@@ -278,6 +284,21 @@ pub fn run(args: &[String]) {
                         let add = AddS::new(&inp.visual).eval(&est, &s.truth[n]);
                         let scale = (est.scale / s.truth[n].scale - 1.0).abs();
                         let id = if n == 0 { sid } else { iid };
+                        if dump {
+                            let stages: Vec<String> = r
+                                .stages
+                                .iter()
+                                .map(|st| format!("{}:{:?}:{:?}:{}", st.stage, st.fit, st.scale, st.accepted))
+                                .collect();
+                            eprintln!(
+                                "DUMP pair {k} seed {seed} object {n}: scale {:?} rotation {:?} translation {:?} stage {} [{}]",
+                                est.scale,
+                                est.rotation.coords.as_slice(),
+                                est.translation.as_slice(),
+                                r.pose_stage,
+                                stages.join(" ")
+                            );
+                        }
                         if verbose && !(add < 0.02 && scale < 0.03) {
                             eprintln!(
                                 "  MISS {id:<44} (pair {k:2}, seed {seed}) ADD-S {:6.2} % scale {:+6.2} % [{}]",

@@ -56,7 +56,7 @@ fn decoded(bytes: &Arc<Vec<u8>>) -> Option<Arc<Image>> {
     {
         return Some(hit);
     }
-    let img = image::load_from_memory(bytes).ok()?.to_rgb8();
+    let img = image::load_from_memory(bytes).ok()?.into_rgb8();
     let img = Arc::new(Image {
         w: img.width(),
         h: img.height(),

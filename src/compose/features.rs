@@ -158,32 +158,60 @@ fn fdist(a: &[f32; DIM], b: &[f32; DIM]) -> f32 {
     a.iter().zip(b).map(|(x, y)| (x - y) * (x - y)).sum()
 }
 
+/// One chunk of rows of the matching: each row's nearest column, and each column's (least
+/// distance, row) over the chunk's rows.
+type Chunk = (Vec<usize>, Vec<(f32, usize)>);
+
 /// Putative correspondences (index in `a`, index in `b`): each point's nearest descriptor in
 /// the other set, both directions, mutual matches first, deterministic order.
 pub fn match_features(a: &Features, b: &Features) -> Vec<(usize, usize)> {
     if a.descriptors.is_empty() || b.descriptors.is_empty() {
         return Vec::new();
     }
-    let nearest = |x: &[f32; DIM], set: &[[f32; DIM]]| -> usize {
-        let mut best = (0, f32::INFINITY);
-        for (j, y) in set.iter().enumerate() {
-            let d = fdist(x, y);
-            if d < best.1 {
-                best = (j, d);
+    // Both directions from one pass over the distance matrix (fdist is symmetric bit for bit:
+    // (x − y)² = (y − x)²): each row's and each column's first index of least distance, as a
+    // scan of the row or the column in index order finds it. Rows are split into chunks; a
+    // later chunk takes a column only with a strictly smaller distance, so the merge keeps the
+    // lowest index of a tie.
+    let chunk = 64;
+    let parts: Vec<Chunk> = a
+        .descriptors
+        .par_chunks(chunk)
+        .enumerate()
+        .map(|(c, rows)| {
+            let mut cols = vec![(f32::INFINITY, 0usize); b.descriptors.len()];
+            let ab = rows
+                .iter()
+                .enumerate()
+                .map(|(r, x)| {
+                    let i = c * chunk + r;
+                    let mut best = (0, f32::INFINITY);
+                    for (j, (y, col)) in b.descriptors.iter().zip(cols.iter_mut()).enumerate() {
+                        let d = fdist(x, y);
+                        if d < best.1 {
+                            best = (j, d);
+                        }
+                        if d < col.0 {
+                            *col = (d, i);
+                        }
+                    }
+                    best.0
+                })
+                .collect();
+            (ab, cols)
+        })
+        .collect();
+    let mut ab: Vec<usize> = Vec::with_capacity(a.descriptors.len());
+    let mut cols = vec![(f32::INFINITY, 0usize); b.descriptors.len()];
+    for (rows, part) in parts {
+        ab.extend(rows);
+        for (col, p) in cols.iter_mut().zip(part) {
+            if p.0 < col.0 {
+                *col = p;
             }
         }
-        best.0
-    };
-    let ab: Vec<usize> = a
-        .descriptors
-        .par_iter()
-        .map(|x| nearest(x, &b.descriptors))
-        .collect();
-    let ba: Vec<usize> = b
-        .descriptors
-        .par_iter()
-        .map(|x| nearest(x, &a.descriptors))
-        .collect();
+    }
+    let ba: Vec<usize> = cols.into_iter().map(|c| c.1).collect();
     let mut mutual = Vec::new();
     let mut rest = Vec::new();
     for (i, &j) in ab.iter().enumerate() {
@@ -200,4 +228,57 @@ pub fn match_features(a: &Features, b: &Features) -> Vec<(usize, usize)> {
     }
     mutual.extend(rest);
     mutual
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The one-pass matcher gives the pairs of two separate nearest-descriptor scans (each
+    /// direction's first index of least distance), on descriptors with many exact ties and more
+    /// rows than one chunk.
+    #[test]
+    fn one_pass_matching_equals_two_scans() {
+        let mut rng = crate::rng::Rng::new(4);
+        let mut set = |n: usize| Features {
+            descriptors: (0..n)
+                .map(|_| std::array::from_fn(|_| rng.below(3) as f32 * 0.5))
+                .collect(),
+            ..Default::default()
+        };
+        for (na, nb) in [(1, 1), (5, 200), (150, 90), (300, 301)] {
+            let (a, b) = (set(na), set(nb));
+            let scan = |x: &[f32; DIM], s: &[[f32; DIM]]| {
+                let d: Vec<f32> = s.iter().map(|y| fdist(x, y)).collect();
+                let m = d.iter().cloned().fold(f32::INFINITY, f32::min);
+                d.iter().position(|&v| v == m).unwrap()
+            };
+            let ab: Vec<usize> = a
+                .descriptors
+                .iter()
+                .map(|x| scan(x, &b.descriptors))
+                .collect();
+            let ba: Vec<usize> = b
+                .descriptors
+                .iter()
+                .map(|x| scan(x, &a.descriptors))
+                .collect();
+            let mut want: Vec<(usize, usize)> = Vec::new();
+            let mut rest = Vec::new();
+            for (i, &j) in ab.iter().enumerate() {
+                if ba[j] == i {
+                    want.push((i, j));
+                } else {
+                    rest.push((i, j));
+                }
+            }
+            for (j, &i) in ba.iter().enumerate() {
+                if ab[i] != j {
+                    rest.push((i, j));
+                }
+            }
+            want.extend(rest);
+            assert_eq!(match_features(&a, &b), want, "{na} × {nb}");
+        }
+    }
 }

@@ -313,24 +313,34 @@ pub fn spins(obb: &Obb, random: usize, seed: u64) -> Vec<UnitQuaternion<f64>> {
 /// centred on its own middle (a fruit's flat spot, a pen's clip) is off by a few per cent.
 pub fn recentred(p: &Problem, t: &Similarity, probe_g: &[usize], iterations: usize) -> Similarity {
     let mut t = *t;
-    let mut res: Vec<(f64, V3)> = Vec::with_capacity(probe_g.len());
+    // (squared residual, order found, residual); the order breaks ties as a stable sort would.
+    let mut res: Vec<(f64, usize, V3)> = Vec::with_capacity(probe_g.len());
+    // Each probe point's partner in the previous step: the next search starts there (the same
+    // answer, found sooner).
+    let mut prev = vec![usize::MAX; probe_g.len()];
     for _ in 0..iterations {
         let m = t.matrix();
         let Some(inv) = m.try_inverse() else { break };
         res.clear();
-        for &gi in probe_g {
+        for (&gi, hint) in probe_g.iter().zip(prev.iter_mut()) {
             let g = p.guidance.points[gi];
-            if let Some((oi, _)) = p.object_tree.nearest(&inv.transform_point(&g)) {
+            if let Some((oi, _)) = p.object_tree.nearest_from(&inv.transform_point(&g), *hint) {
+                *hint = oi;
                 let d = g - m.transform_point(&p.object.points[oi]);
-                res.push((d.norm_squared(), d));
+                res.push((d.norm_squared(), res.len(), d));
             }
         }
         if res.is_empty() {
             break;
         }
-        res.sort_by(|a, b| a.0.total_cmp(&b.0));
         let k = (res.len() * 4 / 5).max(1);
-        t.translation += res[..k].iter().fold(V3::zeros(), |a, r| a + r.1) / k as f64;
+        let by =
+            |a: &(f64, usize, V3), b: &(f64, usize, V3)| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1));
+        if k < res.len() {
+            res.select_nth_unstable_by(k, by);
+        }
+        res[..k].sort_unstable_by(by);
+        t.translation += res[..k].iter().fold(V3::zeros(), |a, r| a + r.2) / k as f64;
     }
     t
 }

@@ -37,6 +37,8 @@ pub struct Guard<'a> {
     object: &'a Cloud,
     tree: &'a KdTree,
     spacing: f64,
+    /// `object.diagonal()`, measured once (every fit scales its cap by it).
+    diagonal: f64,
     probe: Vec<P3>,
     /// Distances are truncated at `cap_fraction` × the object's diagonal at the pose's scale.
     cap_fraction: f64,
@@ -74,6 +76,7 @@ impl<'a> Guard<'a> {
             object,
             tree,
             spacing,
+            diagonal: object.diagonal(),
             probe,
             cap_fraction: 0.03,
             allowance: 0.0,
@@ -102,7 +105,7 @@ impl<'a> Guard<'a> {
 
     /// The fit of pose `t` and the normal offset taken out of it (0 unless measuring offsets).
     fn fit_offset(&self, t: &Similarity) -> (f64, f64) {
-        let diag = t.scale * self.object.diagonal();
+        let diag = t.scale * self.diagonal;
         let cap = self.cap_fixed.unwrap_or(self.cap_fraction * diag);
         match self.offset_fraction {
             None => (
@@ -132,7 +135,7 @@ impl<'a> Guard<'a> {
 
     /// Each probe point's truncated distance at pose `t`, as [`Guard::fit`] averages them.
     fn distances(&self, t: &Similarity) -> Vec<f64> {
-        let diag = t.scale * self.object.diagonal();
+        let diag = t.scale * self.diagonal;
         let cap = self.cap_fixed.unwrap_or(self.cap_fraction * diag);
         match self.offset_fraction {
             None => surface_distances(self.object, self.tree, self.spacing, &self.probe, t, cap),
@@ -161,7 +164,7 @@ impl<'a> Guard<'a> {
     /// charged the same for the guidance points no pose explains (bleed, blur), where a cap
     /// proportional to the scale charges a smaller pose less for each of them.
     pub fn fix_cap(&mut self) -> &mut Self {
-        self.cap_fixed = Some(self.cap_fraction * self.best.scale * self.object.diagonal());
+        self.cap_fixed = Some(self.cap_fraction * self.best.scale * self.diagonal);
         self.best_fit = self.fit(&self.best);
         self
     }

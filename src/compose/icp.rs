@@ -108,6 +108,25 @@ impl<'a> Matcher<'a> {
     }
 }
 
+/// Order the `k` smallest of `pairs` (by distance, then guidance index) first, ascending: the
+/// prefix a full sort gives (the key is a total order, the guidance indices being distinct), at
+/// the cost of a selection and a sort of the prefix only. The order of the rest is unspecified.
+pub(super) fn smallest_sorted(pairs: &mut [(f64, usize, usize)], k: usize) {
+    let by =
+        |a: &(f64, usize, usize), b: &(f64, usize, usize)| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1));
+    let k = k.min(pairs.len());
+    if k < pairs.len() {
+        pairs.select_nth_unstable_by(k, by);
+    }
+    pairs[..k].sort_unstable_by(by);
+}
+
+/// The element at `i` of `v` sorted ascending (`f64::total_cmp`): a median or quantile without
+/// sorting all of `v` (`v` is reordered).
+pub(super) fn nth_smallest(v: &mut [f64], i: usize) -> f64 {
+    *v.select_nth_unstable_by(i, f64::total_cmp).1
+}
+
 /// Transform the object into the guidance points: for each guidance point the nearest object
 /// sample (the guidance part has holes, the object does not, so correspondences go from the
 /// guidance to the object), the worst `1 − keep` dropped, Umeyama on the rest, repeated.
@@ -146,28 +165,30 @@ pub fn trimmed_icp(
         if pairs.len() < 3 {
             break;
         }
-        pairs.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
         let k = ((pairs.len() as f64 * o.keep) as usize).clamp(3, pairs.len());
+        smallest_sorted(&mut pairs, k);
         xs.clear();
         ys.clear();
         for &(_, gi, oi) in &pairs[..k] {
             xs.push(object[oi]);
             ys.push(guidance.points[gi]);
         }
+        let m = t.matrix();
         rms = (xs
             .iter()
             .zip(&ys)
-            .map(|(x, y)| (t.matrix().transform_point(x) - y).norm_squared())
+            .map(|(x, y)| (m.transform_point(x) - y).norm_squared())
             .sum::<f64>()
             / k as f64)
             .sqrt();
         let Some(next) = umeyama(&xs, &ys, o.scale_lo, o.scale_hi) else {
             break;
         };
+        let nm = next.matrix();
         let moved = xs
             .iter()
             .step_by((xs.len() / 32).max(1))
-            .map(|p| (next.matrix().transform_point(p) - t.matrix().transform_point(p)).norm())
+            .map(|p| (nm.transform_point(p) - m.transform_point(p)).norm())
             .fold(0.0, f64::max);
         t = next;
         if moved < o.tolerance {
@@ -181,6 +202,38 @@ pub fn trimmed_icp(
 mod tests {
     use super::*;
     use crate::rng::Rng;
+
+    /// The selection gives the prefix of a full stable sort, element for element, on data with
+    /// many tied distances (the guidance index decides), and the quantile of a full sort.
+    #[test]
+    fn smallest_sorted_is_the_prefix_of_a_full_sort() {
+        let mut rng = Rng::new(3);
+        for n in [1usize, 2, 7, 100, 1500] {
+            let pairs: Vec<(f64, usize, usize)> = (0..n)
+                .map(|i| {
+                    (
+                        (rng.below(20) as f64) * 0.25,
+                        (i * 7919) % n.max(1),
+                        rng.below(50),
+                    )
+                })
+                .collect();
+            // Distinct guidance indices, as ICP's pairs have (one pair per guidance point).
+            let mut seen = std::collections::HashSet::new();
+            assert!(pairs.iter().all(|p| seen.insert(p.1)));
+            let mut full = pairs.clone();
+            full.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+            for k in [0, 1, n / 2, (n as f64 * 0.8) as usize, n] {
+                let mut part = pairs.clone();
+                smallest_sorted(&mut part, k);
+                assert_eq!(part[..k], full[..k], "n {n} k {k}");
+            }
+            let mut v: Vec<f64> = pairs.iter().map(|p| p.0 - 2.0).collect();
+            let mut sorted = v.clone();
+            sorted.sort_by(f64::total_cmp);
+            assert_eq!(nth_smallest(&mut v, n / 2), sorted[n / 2]);
+        }
+    }
 
     #[test]
     fn umeyama_recovers_a_known_similarity_exactly() {

@@ -125,8 +125,8 @@ pub fn plane_icp_offset(
         if pairs.len() < dof + 1 {
             break;
         }
-        pairs.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
         let k = ((pairs.len() as f64 * o.keep) as usize).clamp(dof + 1, pairs.len());
+        super::icp::smallest_sorted(&mut pairs, k);
         let kept = &pairs[..k];
         // Residuals in the guidance frame.
         let rows: Vec<(P3, V3, f64)> = kept
@@ -138,8 +138,8 @@ pub fn plane_icp_offset(
             })
             .collect();
         let mut abs: Vec<f64> = rows.iter().map(|r| r.2.abs()).collect();
-        abs.sort_by(f64::total_cmp);
-        let sigma = 1.4826 * abs[abs.len() / 2];
+        let half = abs.len() / 2;
+        let sigma = 1.4826 * super::icp::nth_smallest(&mut abs, half);
         rms = (rows.iter().map(|r| r.2 * r.2).sum::<f64>() / k as f64).sqrt();
         let thr = (o.huber * sigma).max(1e-300);
         let w = |r: f64| if r.abs() <= thr { 1.0 } else { thr / r.abs() };
@@ -309,8 +309,8 @@ pub fn offset_distances(
     let delta = if signed.is_empty() {
         0.0
     } else {
-        signed.sort_by(f64::total_cmp);
-        signed[signed.len() / 2].clamp(-offset_max, offset_max)
+        let half = signed.len() / 2;
+        super::icp::nth_smallest(&mut signed, half).clamp(-offset_max, offset_max)
     };
     let out = d
         .iter()
