@@ -307,9 +307,15 @@ pub fn run_scene_with(
     settle: &crate::physics::SettleOptions,
 ) -> Result<Ours> {
     let mut a = g.assembly.clone();
+    // The nudge check is on here (it is off by default): the harness reports which verdicts
+    // are undetermined beside the strict agreement.
     let opts = crate::validate::ValidateOptions {
         visual_metrics: false,
         settle: settle.clone(),
+        nudge: crate::validate::nudge::NudgeOptions {
+            enabled: true,
+            ..Default::default()
+        },
         ..Default::default()
     };
     let t = std::time::Instant::now();

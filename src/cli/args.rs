@@ -139,9 +139,12 @@ pub struct CheckArgs {
     /// gate; see docs/validation.md for what each costs).
     #[arg(long, value_enum, default_value = "warn")]
     pub undetermined: crate::validate::Undetermined,
-    /// Skip the run-time nudge check (the verdict is the one settle's: pass or fail).
+    /// Run the nudge check: where one settle's numbers say the verdict may be fragile, settle
+    /// again from the composed pose turned 0.5° four ways and call a split verdict
+    /// `undetermined` (off by default: it costs 4 settles a firing body; `--undetermined fail`
+    /// turns it on).
     #[arg(long)]
-    pub no_nudge_check: bool,
+    pub nudge_check: bool,
 }
 
 impl CheckArgs {
@@ -157,7 +160,8 @@ impl CheckArgs {
         o.visual_metrics = !self.no_visual_metrics;
         o.max_visual_penetration = self.max_visual_penetration;
         o.undetermined = self.undetermined;
-        o.nudge.enabled = !self.no_nudge_check;
+        o.nudge.enabled =
+            self.nudge_check || self.undetermined == crate::validate::Undetermined::Fail;
         o
     }
 }
