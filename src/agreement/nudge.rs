@@ -81,30 +81,9 @@ pub fn verdicts(g: &Generated, settle: &crate::physics::SettleOptions) -> Result
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::mesh::V3;
     use crate::physics::{settle, SettleOptions, SimBody};
-    use nalgebra::{Isometry3, Matrix3, Point3, Translation3, UnitQuaternion, Vector3};
-
-    /// A cube of side `s` leaning at `theta` degrees on one bottom edge (the edge along y, on
-    /// the floor, 0.5 mm above it).
-    fn leaning_cube(s: f64, theta: f64) -> SimBody {
-        let t = theta.to_radians();
-        let r = UnitQuaternion::from_axis_angle(&Vector3::y_axis(), t);
-        // Turned by θ > 0 about y, the edge x = s/2, z = -s/2 of the body frame is the lowest;
-        // put it on the floor at the origin.
-        let edge = r * Point3::new(s / 2.0, 0.0, -s / 2.0);
-        let pose = Isometry3::from_parts(Translation3::new(-edge.x, 0.0, -edge.z + 5e-4), r);
-        SimBody {
-            name: "cube".into(),
-            pose,
-            hulls: vec![crate::shapes::cuboid(V3::new(s, s, s))],
-            mass: 0.2,
-            com: Point3::origin(),
-            inertia: Matrix3::identity() * (0.2 * s * s / 6.0),
-            friction: 0.6,
-            fixed: false,
-        }
-    }
+    use crate::validate::nudge::tests::leaning_cube;
+    use nalgebra::{Isometry3, Point3};
 
     /// Our settle verdict over the nudged starts of one leaning cube.
     fn cube_spread(theta: f64) -> Spread {

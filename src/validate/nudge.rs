@@ -225,15 +225,16 @@ pub fn nudged_verdicts(
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
     use crate::mesh::V3;
     use crate::physics::settle;
     use nalgebra::Matrix3;
 
     /// A cube of side `s` leaning at `theta` degrees on one bottom edge (the edge along y on
-    /// the floor, 0.5 mm above it), as in `agreement::nudge`'s test.
-    fn leaning_cube(s: f64, theta: f64) -> SimBody {
+    /// the floor, 0.5 mm above it); `agreement::nudge`'s test uses it too. Turned by θ > 0
+    /// about y, the edge x = s/2, z = -s/2 of the body frame is the lowest.
+    pub(crate) fn leaning_cube(s: f64, theta: f64) -> SimBody {
         let r = UnitQuaternion::from_axis_angle(&Vector3::y_axis(), theta.to_radians());
         let edge = r * Point3::new(s / 2.0, 0.0, -s / 2.0);
         SimBody {
