@@ -334,12 +334,7 @@ pub fn recentred(p: &Problem, t: &Similarity, probe_g: &[usize], iterations: usi
             break;
         }
         let k = (res.len() * 4 / 5).max(1);
-        let by =
-            |a: &(f64, usize, V3), b: &(f64, usize, V3)| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1));
-        if k < res.len() {
-            res.select_nth_unstable_by(k, by);
-        }
-        res[..k].sort_unstable_by(by);
+        super::icp::smallest_sorted(&mut res, k, |r| (r.0, r.1));
         t.translation += res[..k].iter().fold(V3::zeros(), |a, r| a + r.2) / k as f64;
     }
     t

@@ -108,17 +108,21 @@ impl<'a> Matcher<'a> {
     }
 }
 
-/// Order the `k` smallest of `pairs` (by distance, then guidance index) first, ascending: the
-/// prefix a full sort gives (the key is a total order, the guidance indices being distinct), at
-/// the cost of a selection and a sort of the prefix only. The order of the rest is unspecified.
-pub(super) fn smallest_sorted(pairs: &mut [(f64, usize, usize)], k: usize) {
-    let by =
-        |a: &(f64, usize, usize), b: &(f64, usize, usize)| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1));
-    let k = k.min(pairs.len());
-    if k < pairs.len() {
-        pairs.select_nth_unstable_by(k, by);
+/// Order the `k` smallest of `items` by `key` (a distance, then a distinct index) first,
+/// ascending: the prefix a full sort gives (the key is a total order, the indices being
+/// distinct), at the cost of a selection and a sort of the prefix only. The order of the rest
+/// is unspecified. ICP's pairs use (distance, guidance index); `global::recentred` its
+/// residuals in the order found.
+pub(super) fn smallest_sorted<T>(items: &mut [T], k: usize, key: impl Fn(&T) -> (f64, usize)) {
+    let by = |a: &T, b: &T| {
+        let (a, b) = (key(a), key(b));
+        a.0.total_cmp(&b.0).then(a.1.cmp(&b.1))
+    };
+    let k = k.min(items.len());
+    if k < items.len() {
+        items.select_nth_unstable_by(k, by);
     }
-    pairs[..k].sort_unstable_by(by);
+    items[..k].sort_unstable_by(by);
 }
 
 /// The element at `i` of `v` sorted ascending (`f64::total_cmp`): a median or quantile without
@@ -166,7 +170,7 @@ pub fn trimmed_icp(
             break;
         }
         let k = ((pairs.len() as f64 * o.keep) as usize).clamp(3, pairs.len());
-        smallest_sorted(&mut pairs, k);
+        smallest_sorted(&mut pairs, k, |p| (p.0, p.1));
         xs.clear();
         ys.clear();
         for &(_, gi, oi) in &pairs[..k] {
@@ -225,7 +229,7 @@ mod tests {
             full.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
             for k in [0, 1, n / 2, (n as f64 * 0.8) as usize, n] {
                 let mut part = pairs.clone();
-                smallest_sorted(&mut part, k);
+                smallest_sorted(&mut part, k, |p| (p.0, p.1));
                 assert_eq!(part[..k], full[..k], "n {n} k {k}");
             }
             let mut v: Vec<f64> = pairs.iter().map(|p| p.0 - 2.0).collect();

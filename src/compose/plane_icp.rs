@@ -126,7 +126,7 @@ pub fn plane_icp_offset(
             break;
         }
         let k = ((pairs.len() as f64 * o.keep) as usize).clamp(dof + 1, pairs.len());
-        super::icp::smallest_sorted(&mut pairs, k);
+        super::icp::smallest_sorted(&mut pairs, k, |p| (p.0, p.1));
         let kept = &pairs[..k];
         // Residuals in the guidance frame.
         let rows: Vec<(P3, V3, f64)> = kept

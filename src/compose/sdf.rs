@@ -1,7 +1,7 @@
 //! The anchor's signed distance field Φ (negative inside): a grid whose nodes are computed when
-//! a query first needs them ([`SdfGrid`]), trilinear with an analytic gradient, and exact queries (nearest triangle + the metrics' inside test) in a thin
-//! band around the surface, where a grid would blur thin walls (a 4 mm bowl wall is a fraction
-//! of a cell).
+//! a query first needs them ([`SdfGrid`]), trilinear with an analytic gradient, and exact
+//! queries (nearest triangle + the metrics' inside test) in a thin band around the surface,
+//! where a grid would blur thin walls (a 4 mm bowl wall is a fraction of a cell).
 
 use crate::mesh::{Aabb, Mesh, P3, V3};
 use crate::metrics::{Prepared, Solid};

@@ -236,16 +236,18 @@ pub fn validate(a: &Assembly, opts: &ValidateOptions) -> Result<Validation> {
         path: a.name.clone().into(),
         message: format!("cannot simulate: {e}"),
     })?;
+    // The nudge check only asks about the settle: a scene failing a static check (the checks so
+    // far) fails anyway.
+    let statics_pass = checks.iter().all(|c| c.passed);
     checks.extend(dynamic_checks(&settle, &opts.settle));
     warnings.extend(settle.warnings.iter().cloned());
     let unnudged = checks.iter().all(|c| c.passed) && settle.passed;
-    // The nudge check only asks about the settle: a scene failing a static check fails anyway.
-    let statics_pass = checks
-        .iter()
-        .filter(|c| c.name.ends_with("_penetration"))
-        .all(|c| c.passed);
-    let signals = nudge::signals(&settle, &opts.settle, &opts.nudge);
-    let nudged = (opts.nudge.enabled && statics_pass && !signals.is_empty()).then(|| {
+    let signals = if opts.nudge.enabled && statics_pass {
+        nudge::signals(&settle, &opts.settle, &opts.nudge)
+    } else {
+        Vec::new()
+    };
+    let nudged = (!signals.is_empty()).then(|| {
         let mut which = vec![false; sims.len()];
         for (i, _) in &signals {
             which[*i] = true;
