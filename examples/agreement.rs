@@ -272,6 +272,7 @@ fn set(o: &mut SettleOptions, kv: &str) {
         "probe_time" => o.probe_time = x,
         "max_rest_motion" => o.max_rest_motion = x,
         "max_rest_rotation_deg" => o.max_rest_rotation_deg = x,
+        "max_rest_penetration" => o.max_rest_penetration = x,
         "creep_max_motion" => o.creep_max_motion = x,
         "creep_max_rotation_deg" => o.creep_max_rotation_deg = x,
         "creep_contact_distance" => o.creep_contact_distance = x,
