@@ -15,6 +15,8 @@
 //! outliers, uncovered surface, normal offset, extent ratio), which tells a registration miss from
 //! a part that does not show the object's size. With `-v`, each miss's stage log and
 //! `miss_probe`: the fit at the truth against the estimate, and along a scale sweep.
+//! `--profile-probe`: no compose; each object's scale from its axial profile alone against the
+//! truth (`profile_probe`; `PROFILE_DUMP=1` prints the model's and the guidance's profiles).
 //!
 //! cargo run --release --example bench_compose [-- --seeds N] [--seed-offset N] [--threads N]
 //!     [--jobs N] [--only SUBSTRING,...] [-v]
@@ -31,6 +33,7 @@ use std::time::Instant;
 
 mod guidance_stats;
 mod miss_probe;
+mod profile_probe;
 mod realistic_bench;
 
 struct Case {

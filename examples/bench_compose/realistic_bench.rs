@@ -14,6 +14,7 @@ use std::time::Instant;
 
 use super::guidance_stats::{self, GuidanceStats};
 use super::miss_probe;
+use super::profile_probe;
 
 /// (support or container, item, spread of the item's position over the support's half
 /// footprint). Every one of the 43 shared objects appears; flat supports: the plate, the
@@ -166,6 +167,8 @@ pub fn run(args: &[String]) {
         .map(|s| s.split(',').map(str::to_string).collect())
         .unwrap_or_default();
     let verbose = args.iter().any(|a| a == "-v");
+    // `--profile-probe`: the axial profile's scale of each object, no compose ([`profile_probe`]).
+    let profile_only = args.iter().any(|a| a == "--profile-probe");
     // `--dump`: each object's pose and stage fits at full precision (stderr), so two builds
     // can be diffed for the same results (a cost-only change must print the same lines).
     let dump = args.iter().any(|a| a == "--dump");
@@ -248,6 +251,16 @@ pub fn run(args: &[String]) {
                             tris.join(" / "),
                             t_gen.elapsed().as_secs_f64()
                         );
+                    }
+                    if profile_only {
+                        for (n, inp) in s.inputs.iter().enumerate() {
+                            let id = if n == 0 { sid } else { iid };
+                            profile_probe::print(id, seed, inp, &s.truth[n]);
+                            if std::env::var_os("PROFILE_DUMP").is_some() {
+                                profile_probe::dump(inp, &s.truth[n]);
+                            }
+                        }
+                        continue;
                     }
                     let gstats: Vec<GuidanceStats> = s
                         .inputs
