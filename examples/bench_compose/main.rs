@@ -33,6 +33,7 @@ use std::time::Instant;
 
 mod guidance_stats;
 mod miss_probe;
+mod profile;
 mod profile_probe;
 mod realistic_bench;
 

@@ -1,12 +1,12 @@
 //! `--profile-probe`: the scale the axial profile alone gives each object (no `compose`), against
 //! the truth: the object's long axis (its OBB's) mapped into the guidance frame by the true
 //! rotation (`truth axis`) or taken from the guidance part's own OBB (`own axis`), the model's
-//! profile matched onto the guidance's ([`interact3d::compose::profile`]). Tells whether the
+//! profile matched onto the guidance's (`profile.rs` beside it). Tells whether the
 //! profile carries the size before anything is wired into the pipeline.
 
+use crate::profile::{fit, FitOptions, Profile, ProfileFit};
 use interact3d::compose::cloud::Cloud;
 use interact3d::compose::obb::Obb;
-use interact3d::compose::profile::{fit, FitOptions, Profile, ProfileFit};
 use interact3d::compose::ObjectInput;
 use interact3d::mesh::V3;
 use interact3d::pose::Similarity;

@@ -32,7 +32,6 @@ pub mod kdtree;
 pub mod obb;
 pub mod occlusion;
 pub mod plane_icp;
-pub mod profile;
 pub mod realistic;
 pub mod reconstruction;
 pub mod refine;

@@ -11,7 +11,7 @@
 //! Entry points: [`Profile::along`] (the widths of points binned along an axis), [`fit`] (the
 //! scale, offset and direction that best map a model profile onto a guidance profile).
 
-use crate::mesh::{P3, V3};
+use interact3d::mesh::{P3, V3};
 
 /// Cross-section widths of a point set along an axis.
 #[derive(Clone, Debug)]
@@ -318,7 +318,7 @@ pub fn fit(model: &Profile, guidance: &Profile, o: &FitOptions) -> Option<Profil
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::rng::Rng;
+    use interact3d::rng::Rng;
 
     /// A stepped bar along x: a handle of radius 0.08 over [0, 0.4), a shaft of radius 0.02 over
     /// [0.4, 1.0]: points on the side surfaces (by area), with `holes` (axial intervals with no
