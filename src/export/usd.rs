@@ -11,7 +11,9 @@
 //! UVs) and `Collisions` (one guide-purpose `Mesh` per hull, `convexHull` approximation,
 //! `PhysxConvexHullCollisionAPI` vertex limit 64, bound to the physics material). The scene
 //! file: a `PhysicsScene` with gravity, a static ground box, and every object referenced at its
-//! initial pose, the composed pose in `customData`, fixed objects static.
+//! initial pose, the composed pose in `customData`, fixed objects static. Both say, in PhysX's
+//! schemas, what our settle test assumed ([`PhysxCtx`]: damping, depenetration speed, friction
+//! combine rule, rest offset, the floor's friction).
 
 use super::files::{material_groups, BodyFiles};
 use super::format::f;
@@ -69,12 +71,13 @@ struct ObjectCtx {
 
 /// The PhysX settings the files author (`PhysxRigidBodyAPI`, `PhysxMaterialAPI`,
 /// `PhysxCollisionAPI`, the ground's friction): what the settle test that validated the pose
-/// assumed, so that PhysX simulates the same world instead of its own defaults. PhysX's defaults
-/// differ on angular damping (0.05 where Rapier has none) and on the contact offset (an
-/// engine-chosen distance, centimetres, where Rapier predicts contacts 2 mm out); the ground's
-/// friction was 1 where the settle's floor has 0.8. The rest is PhysX's default authored so
-/// that the file says it: friction combined by averaging (Rapier's rule), rest offset 0,
-/// depenetration at most 3 m/s (Rapier's `max_corrective_velocity`), no linear damping.
+/// assumed, so that PhysX simulates the same world instead of its own defaults. PhysX's default
+/// differs on angular damping (0.05 where Rapier has none); the ground's friction was 1 where
+/// the settle's floor has 0.8. The rest is PhysX's default authored so that the file says it:
+/// friction combined by averaging (Rapier's rule), rest offset 0, depenetration at most 3 m/s
+/// (Rapier's `max_corrective_velocity`), no linear damping. The contact offset stays PhysX's
+/// own: Rapier's 2 mm prediction distance (1 mm a shape) let PhysX topple two shoes in mugs from
+/// the composed pose that it holds with its default (docs/agreement.md, session 15).
 #[derive(Clone, Serialize)]
 pub struct PhysxCtx {
     /// `physxRigidBody:angularDamping`, `linearDamping` (1/s).
@@ -84,9 +87,6 @@ pub struct PhysxCtx {
     max_depenetration_velocity: String,
     /// `physxMaterial:frictionCombineMode` of every material, the ground's included.
     friction_combine: &'static str,
-    /// `physxCollision:contactOffset` of every collider (m): half the settle's prediction
-    /// distance, since PhysX adds the two shapes' offsets.
-    contact_offset: String,
     /// The ground's friction coefficient.
     floor_friction: String,
 }
@@ -100,7 +100,6 @@ impl PhysxCtx {
             max_depenetration_velocity: f(o.max_corrective_velocity),
             // Rapier's default combine rule; the settle never sets another.
             friction_combine: "average",
-            contact_offset: f(0.5 * o.prediction_distance),
             floor_friction: f(o.floor_friction),
         }
     }
