@@ -225,6 +225,10 @@ fn judge(scene: &Path, extra: &[&str]) -> (serde_json::Value, serde_json::Value)
         }
     }
 
+    // The PhysX settings the settle test assumed, as usd-core reads them with the PhysX schemas
+    // registered: every body, collider and material carries them (src/export/usd.rs, PhysxCtx).
+    physx_settings_are_the_settles(&u, objects, &what.to_string());
+
     // PhysX cooks every hull as written: its cooked vertices are authored ones, and every
     // authored vertex lies within 0.1 mm of the cooked hull (PhysX may drop a vertex that sits
     // on a face or an edge, never one that shapes the hull).
@@ -277,6 +281,89 @@ fn judge(scene: &Path, extra: &[&str]) -> (serde_json::Value, serde_json::Value)
         }
     }
     (report, u)
+}
+
+/// Every body has `PhysxRigidBodyAPI` with the settle's damping and depenetration speed, every
+/// hull and the ground `PhysxCollisionAPI` with rest offset 0 (and PhysX's own contact offset), every material `PhysxMaterialAPI` averaging
+/// friction as Rapier does, and the ground has the settle's floor friction.
+fn physx_settings_are_the_settles(
+    u: &serde_json::Value,
+    objects: &[serde_json::Value],
+    what: &str,
+) {
+    let o = interact3d::physics::SettleOptions::default();
+    let authored = u["physx_authored"].as_object().unwrap();
+    let with = |schema: &str| -> Vec<(&String, &serde_json::Value)> {
+        authored
+            .iter()
+            .filter(|(_, r)| r["schemas"].as_array().unwrap().iter().any(|s| s == schema))
+            .collect()
+    };
+    // Authored as float (32 bits).
+    let near = |v: &serde_json::Value, want: f64| (f(v) - want).abs() <= 1e-7 * want.abs().max(1.0);
+    let bodies = with("PhysxRigidBodyAPI");
+    assert_eq!(bodies.len(), objects.len(), "{what}: {:?}", bodies);
+    for (p, r) in &bodies {
+        let a = &r["attrs"];
+        assert!(
+            near(&a["physxRigidBody:angularDamping"], o.angular_damping),
+            "{what}: {p}: {a}"
+        );
+        assert!(
+            near(&a["physxRigidBody:linearDamping"], o.linear_damping),
+            "{what}: {p}: {a}"
+        );
+        assert!(
+            near(
+                &a["physxRigidBody:maxDepenetrationVelocity"],
+                o.max_corrective_velocity
+            ),
+            "{what}: {p}: {a}"
+        );
+    }
+    let hulls: u64 = objects
+        .iter()
+        .map(|o| o["hull_count"].as_u64().unwrap())
+        .sum();
+    let colliders = with("PhysxCollisionAPI");
+    assert_eq!(
+        colliders.len() as u64,
+        hulls + 1,
+        "{what}: every hull and the ground"
+    );
+    for (p, r) in &colliders {
+        let a = &r["attrs"];
+        // PhysX's own contact offset (not authored): Rapier's 2 mm toppled two scenes.
+        assert!(
+            a.get("physxCollision:contactOffset").is_none(),
+            "{what}: {p}: {a}"
+        );
+        assert!(
+            near(&a["physxCollision:restOffset"], 0.0),
+            "{what}: {p}: {a}"
+        );
+    }
+    let materials = with("PhysxMaterialAPI");
+    assert_eq!(
+        materials.len(),
+        objects.len() + 1,
+        "{what}: every object's and the ground's"
+    );
+    for (p, r) in &materials {
+        assert_eq!(
+            r["attrs"]["physxMaterial:frictionCombineMode"], "average",
+            "{what}: {p}"
+        );
+    }
+    let ground = &authored["/World/Ground/PhysicsMaterial"]["attrs"];
+    assert!(
+        near(&ground["physics:staticFriction"], o.floor_friction),
+        "{what}: {ground}"
+    );
+    assert!(
+        near(&ground["physics:dynamicFriction"], o.floor_friction),
+        "{what}: {ground}"
+    );
 }
 
 #[test]

@@ -34,7 +34,8 @@ use std::path::Path;
 /// What a tool version writes into generated files.
 pub const GENERATOR: &str = concat!("interact3d ", env!("CARGO_PKG_VERSION"));
 
-/// Friction of the floor in the scene files (MJCF and USD).
+/// Friction of the floor in the MJCF (MuJoCo combines by the maximum; the USD's floor has the
+/// settle test's friction, combined by averaging as Rapier does: [`usd::PhysxCtx`]).
 const FLOOR_FRICTION: f64 = 1.0;
 
 /// Options of the export stage.
@@ -83,7 +84,12 @@ fn write_all(
         .collect();
     // The USD files and the MJCF/URDF/JSON ones share nothing but their inputs.
     let (usd, rest) = rayon::join(
-        || usd::write_usd(assembly, &body_files, dir, templates, FLOOR_FRICTION),
+        || {
+            // The USD says what the settle test assumed (export follows validation with the
+            // default options); the MJCF keeps its own floor (MuJoCo takes the larger friction).
+            let physx = usd::PhysxCtx::from_settle(&crate::physics::SettleOptions::default());
+            usd::write_usd(assembly, &body_files, dir, templates, &physx)
+        },
         || write_mjcf_urdf_json(assembly, report, dir, templates, &ctx_bodies),
     );
     usd?;

@@ -11,7 +11,9 @@
 //! UVs) and `Collisions` (one guide-purpose `Mesh` per hull, `convexHull` approximation,
 //! `PhysxConvexHullCollisionAPI` vertex limit 64, bound to the physics material). The scene
 //! file: a `PhysicsScene` with gravity, a static ground box, and every object referenced at its
-//! initial pose, the composed pose in `customData`, fixed objects static.
+//! initial pose, the composed pose in `customData`, fixed objects static. Both say, in PhysX's
+//! schemas, what our settle test assumed ([`PhysxCtx`]: damping, depenetration speed, friction
+//! combine rule, rest offset, the floor's friction).
 
 use super::files::{material_groups, BodyFiles};
 use super::format::f;
@@ -19,6 +21,7 @@ use super::{Templates, GENERATOR};
 use crate::body::{Assembly, Body};
 use crate::error::Result;
 use crate::mesh::{P3, V3};
+use crate::physics::SettleOptions;
 use nalgebra::{Matrix3, Rotation3, UnitQuaternion, Vector3};
 use rayon::prelude::*;
 use serde::Serialize;
@@ -66,14 +69,51 @@ struct ObjectCtx {
     hulls: Vec<MeshCtx>,
 }
 
+/// The PhysX settings the files author (`PhysxRigidBodyAPI`, `PhysxMaterialAPI`,
+/// `PhysxCollisionAPI`, the ground's friction): what the settle test that validated the pose
+/// assumed, so that PhysX simulates the same world instead of its own defaults. PhysX's default
+/// differs on angular damping (0.05 where Rapier has none); the ground's friction was 1 where
+/// the settle's floor has 0.8. The rest is PhysX's default authored so that the file says it:
+/// friction combined by averaging (Rapier's rule), rest offset 0, depenetration at most 3 m/s
+/// (Rapier's `max_corrective_velocity`), no linear damping. The contact offset stays PhysX's
+/// own: Rapier's 2 mm prediction distance (1 mm a shape) let PhysX topple two shoes in mugs from
+/// the composed pose that it holds with its default (docs/agreement.md, session 15).
+#[derive(Clone, Serialize)]
+pub struct PhysxCtx {
+    /// `physxRigidBody:angularDamping`, `linearDamping` (1/s).
+    angular_damping: String,
+    linear_damping: String,
+    /// `physxRigidBody:maxDepenetrationVelocity` (m/s).
+    max_depenetration_velocity: String,
+    /// `physxMaterial:frictionCombineMode` of every material, the ground's included.
+    friction_combine: &'static str,
+    /// The ground's friction coefficient.
+    floor_friction: String,
+}
+
+impl PhysxCtx {
+    /// The settings of the settle test `o`.
+    pub fn from_settle(o: &SettleOptions) -> Self {
+        PhysxCtx {
+            angular_damping: f(o.angular_damping),
+            linear_damping: f(o.linear_damping),
+            max_depenetration_velocity: f(o.max_corrective_velocity),
+            // Rapier's default combine rule; the settle never sets another.
+            friction_combine: "average",
+            floor_friction: f(o.floor_friction),
+        }
+    }
+}
+
 /// Write `scene.usda` and `<object>.usda` for every body into `dir` (the export folder, whose
-/// `meshes/` already holds the textures named in `files`, one entry per body).
+/// `meshes/` already holds the textures named in `files`, one entry per body), with the PhysX
+/// settings `physx`.
 pub fn write_usd(
     a: &Assembly,
     files: &[BodyFiles],
     dir: &Path,
     templates: &Templates,
-    floor_friction: f64,
+    physx: &PhysxCtx,
 ) -> Result<()> {
     let prims = prim_names(a.bodies.iter().map(|b| b.name.as_str()));
     // One file per body, written side by side; the first error in body order is reported.
@@ -90,7 +130,12 @@ pub fn write_usd(
             let ctx = object_context(b, fl, prim);
             let text = templates.render(
                 "object.usda.j2",
-                minijinja::context! { generator => GENERATOR, b => ctx.clone(), hull_scale => hull_scale() },
+                minijinja::context! {
+                    generator => GENERATOR,
+                    b => ctx.clone(),
+                    hull_scale => hull_scale(),
+                    physx => physx,
+                },
             )?;
             crate::fsutil::write(&dir.join(&ctx.file), text.as_bytes())?;
             // The scene needs no mesh data.
@@ -108,7 +153,8 @@ pub fn write_usd(
         minijinja::context! {
             generator => GENERATOR,
             bodies => objects,
-            floor_friction => f(floor_friction),
+            floor_friction => physx.floor_friction.clone(),
+            physx => physx,
         },
     )?;
     crate::fsutil::write(&dir.join("scene.usda"), text.as_bytes())

@@ -13,7 +13,7 @@ Same input and output as agreement_mujoco.py (one JSON line per scene on stdout)
   w, x, y, z) for the caller's large-turn rule;
 - from scene.usda as exported (the settled pose): the worst displacement and turn of each body
   over 2 s.
-Poses are PhysX's rigid-body poses, read every step (the export puts the body frame at the
+Poses are PhysX's rigid-body poses, read every step of the rest parts (every 24th of the settle part) (the export puts the body frame at the
 centre of mass). Time step 1/240 s, PhysX's defaults otherwise (what scene.usda says).
 Engine chatter goes to stderr.
 """
@@ -31,6 +31,11 @@ DT = 1.0 / 240.0
 SETTLE_S = 6.0
 REST_S = 1.0
 FROM_SETTLED_S = 2.0
+# Over the settle part only the end pose counts (and that every pose stays finite, which a
+# non-finite pose never recovers from): read every 24 steps (10 Hz). Reading every step cost
+# 3x the whole judge (4 ms a read, 0.15 ms a step, ovphysx CPU, 2-body scene) and gives the
+# same verdicts.
+SETTLE_READ_EVERY = 24
 
 
 # The PhysX driver's helpers (this folder is the script's own, first on sys.path).
@@ -84,12 +89,17 @@ class Run:
         rows = read_rigid_bodies(self.physx, ["position", "orientation"])
         return {p: (r["position"], r["orientation"]) for p, r in rows.items() if len(r) == 2}
 
-    def run(self, seconds, start):
-        """Step `seconds`; worst displacement and turn of each body from `start`."""
+    def run(self, seconds, start, every=1):
+        """Step `seconds`; worst displacement and turn of each body from `start`, read every
+        `every` steps and after the last (a read costs about 25 steps of a small scene, so the
+        settle part, whose worst is not used, reads only to see that the poses stay finite)."""
         worst = {p: [0.0, 0.0] for p in start}
         finite = True
-        for _ in range(int(round(seconds / DT))):
+        n = int(round(seconds / DT))
+        for k in range(n):
             self.physx.step_sync(DT)
+            if (k + 1) % every != 0 and k + 1 != n:
+                continue
             now = self.poses()
             for p, (x0, q0) in start.items():
                 x, q = now.get(p, (x0, q0))
@@ -121,7 +131,7 @@ def judge(entry):
     try:
         r = Run(composed_path)
         composed = dynamic_only(r.poses(), names)
-        _, finite1 = r.run(entry.get("settle_s", SETTLE_S), composed)
+        _, finite1 = r.run(entry.get("settle_s", SETTLE_S), composed, every=SETTLE_READ_EVERY)
         after = r.poses()
         settle = {p: float(np.linalg.norm(after[p][0] - composed[p][0])) for p in composed}
         rest, finite2 = r.run(REST_S, {p: after[p] for p in composed})

@@ -8,6 +8,10 @@ usage: check_usd.py OUT_DIR [--seconds S] [--dt DT] [--no-physx] [--newton]
 - "usdphysics": what UsdPhysicsLoadStageFromPrimRange finds in scene.usda: per body, its shapes
   and their approximations, whether it is dynamic, its mass and the full inertia tensor rebuilt
   from diagonalInertia and principalAxes (I = R diag(d) R^T), its world pose; plus the scene.
+- "physx_authored": every prim of the composed scene.usda with a Physx* API schema applied (usd-core
+  with the PhysX schemas registered): its applied schemas and its physx* attribute values, and
+  for materials their physics:staticFriction / dynamicFriction (the settings the export says our
+  settle assumed; tests/usd.rs compares them with SettleOptions).
 - "physx": scene.usda simulated S seconds (default 2) on the CPU by PhysX (ovphysx): per dynamic
   body, the displacement (m) and rotation (degrees) of its frame, and the mass PhysX took; and
   "cooked": the convex hulls PhysX collides with, read back from its debug geometry and compared
@@ -140,6 +144,26 @@ def usd_physics(out):
         p for p, (o, d) in shapes.items() if str(d.rigidBody) in ("", "None") or not str(d.rigidBody)
     )
     return {"scenes": scenes, "bodies": out_bodies, "static_shapes": statics}
+
+
+def physx_authored(out):
+    from pxr import Usd
+
+    stage = Usd.Stage.Open(os.path.join(out, "scene.usda"))
+    rows = {}
+    for prim in stage.Traverse():
+        schemas = [str(s) for s in prim.GetAppliedSchemas()]
+        if not any(s.startswith("Physx") for s in schemas):
+            continue
+        attrs = {}
+        for a in prim.GetAttributes():
+            n = a.GetName()
+            authored = n.startswith("physx") or n in ("physics:staticFriction", "physics:dynamicFriction")
+            if authored and a.HasAuthoredValue():
+                v = a.Get()
+                attrs[n] = v if isinstance(v, str) else float(v) if v is not None else None
+        rows[str(prim.GetPath())] = {"schemas": schemas, "attrs": attrs}
+    return rows
 
 
 def authored_hulls(out):
@@ -375,7 +399,11 @@ def main():
         import physx_usd_schemas  # registers the PhysX schemas with usd-core
 
         physx_usd_schemas.register_all()
-        result = {"files": validate_files(out), "usdphysics": usd_physics(out)}
+        result = {
+            "files": validate_files(out),
+            "usdphysics": usd_physics(out),
+            "physx_authored": physx_authored(out),
+        }
         if physx:
             r = run_physx(out, seconds, dt)
             cooked = r.pop("cooked_points")
