@@ -10,7 +10,8 @@
 //! pipeline's (seed s). Reported: ADD-S (fraction of the object's diagonal) and scale error per
 //! object, success within 2 % ADD-S & 3 % scale and within 5 % & 5 %, per seed; R_volume of each
 //! composed scene (100k points); which stage's pose won; time per pair (compose only, on
-//! `--threads` cores, 1 by default).
+//! `--threads` cores, 1 by default), and the slowest pairs (10; with `-v` every pair) with
+//! their objects' triangle counts and texture sizes.
 //! Beside each object: how far its guidance part is from the true surface (`guidance_stats`:
 //! outliers, uncovered surface, normal offset, extent ratio), which tells a registration miss from
 //! a part that does not show the object's size. With `-v`, each miss's stage log and

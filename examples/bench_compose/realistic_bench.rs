@@ -128,6 +128,33 @@ struct SceneRecord {
     /// The true item's exact gap to the true support, as a fraction of its diagonal.
     truth_gap: f64,
     secs: f64,
+    /// What the pair's cost depends on, for the slowest-pairs list: each input's triangles
+    /// (object mesh, guidance part) and largest texture.
+    sizes: [ObjectSize; 2],
+}
+
+/// An input's size: the object's and its guidance part's triangles, its largest texture.
+#[derive(Clone, Copy, Default)]
+struct ObjectSize {
+    tris: usize,
+    guidance_tris: usize,
+    texture: (u32, u32),
+}
+
+fn object_size(inp: &interact3d::compose::ObjectInput) -> ObjectSize {
+    let texture = inp
+        .visual
+        .parts
+        .iter()
+        .filter_map(|p| p.material.texture.as_ref())
+        .map(|t| (t.width, t.height))
+        .max_by_key(|&(w, h)| w as u64 * h as u64)
+        .unwrap_or((0, 0));
+    ObjectSize {
+        tris: inp.visual.triangle_count(),
+        guidance_tris: inp.guidance.triangle_count(),
+        texture,
+    }
 }
 
 /// CPU time of the calling thread (s), from /proc (10 ms ticks); 0 where unavailable.
@@ -378,6 +405,7 @@ pub fn run(args: &[String]) {
                         truth_r_volume: rv(&truth_placed),
                         truth_gap: rest::mesh_gap(&truth_placed[0], &truth_placed[1]) / diagonal,
                         secs,
+                        sizes: [object_size(&s.inputs[0]), object_size(&s.inputs[1])],
                     };
                     if verbose {
                         eprintln!(
@@ -395,6 +423,18 @@ pub fn run(args: &[String]) {
     });
     let mut results = results.into_inner().unwrap();
     results.sort_by_key(|r| r.0);
+    let slowest: Vec<(usize, &SceneRecord)> = {
+        let mut v: Vec<(usize, &SceneRecord)> =
+            results.iter().map(|r| (r.1[0].pair, &r.2)).collect();
+        // Slowest first; ties by pair, then seed (the listing does not depend on the jobs).
+        v.sort_by(|a, b| {
+            b.1.secs
+                .total_cmp(&a.1.secs)
+                .then(a.0.cmp(&b.0))
+                .then(a.1.seed.cmp(&b.1.seed))
+        });
+        v
+    };
     let recs: Vec<&Record> = results.iter().flat_map(|r| &r.1).collect();
     let scenes: Vec<&SceneRecord> = results.iter().map(|r| &r.2).collect();
     let ok2 = |r: &Record| r.add_s < 0.02 && r.scale < 0.03;
@@ -495,6 +535,41 @@ pub fn run(args: &[String]) {
                 .map(|(s, c)| format!("{s} ×{c}"))
                 .collect::<Vec<_>>()
                 .join(", ")
+        );
+    }
+    let n_slow = if verbose {
+        slowest.len()
+    } else {
+        slowest.len().min(10)
+    };
+    println!(
+        "\n#### The slowest pairs ({} of {}; s of `compose` a pair, CPU on one thread, else wall)\n",
+        n_slow,
+        slowest.len()
+    );
+    println!("| s | pair | seed | support | item | support tris (guidance) | item tris (guidance) | support texture | item texture |");
+    println!("|---:|---:|---:|---|---|---:|---:|---:|---:|");
+    let tex = |t: (u32, u32)| {
+        if t.0 == 0 {
+            "-".to_string()
+        } else {
+            format!("{}×{}", t.0, t.1)
+        }
+    };
+    for &(k, s) in &slowest[..n_slow] {
+        let [a, b] = s.sizes;
+        println!(
+            "| {:.2} | {k} | {} | {} | {} | {} ({}) | {} ({}) | {} | {} |",
+            s.secs,
+            s.seed,
+            PAIRS[k].0,
+            PAIRS[k].1,
+            a.tris,
+            a.guidance_tris,
+            b.tris,
+            b.guidance_tris,
+            tex(a.texture),
+            tex(b.texture)
         );
     }
     println!(

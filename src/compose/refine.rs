@@ -95,27 +95,44 @@ fn apply(t: &Similarity, omega: &V3, tau: &V3, c: &P3) -> Similarity {
 /// has moved since is still at least `floor` cannot contribute to a term that only sees
 /// Φ < `floor`, and is not evaluated again. This gives the same energies and gradients as
 /// evaluating Φ at every sample, at a fraction of the cost: most samples are far from the anchor.
+///
+/// A sample asked for again at the very point of its last evaluation (bit for bit) gets that
+/// evaluation back: a stage starts at the pose its previous line search accepted, where every
+/// sample in the band was just evaluated, and Φ is a pure function of the point.
 struct LazyField<'a> {
     field: &'a AnchorField,
     /// (where Φ was last evaluated, Φ there, ∇Φ there) per sample.
     last: Vec<(P3, f64, V3)>,
+    /// Whether an evaluation at the same point is reused (off only to test that it changes
+    /// nothing).
+    reuse: bool,
+    /// Evaluations of the field.
+    evals: usize,
 }
 
 impl<'a> LazyField<'a> {
-    fn new(field: &'a AnchorField, n: usize) -> Self {
+    fn new(field: &'a AnchorField, n: usize, reuse: bool) -> Self {
         LazyField {
             field,
             last: vec![(P3::origin(), f64::NEG_INFINITY, V3::zeros()); n],
+            reuse,
+            evals: 0,
         }
     }
 
     /// Φ(x) and ∇Φ(x) of sample `i` now at `x`, or `None` when Φ(x) ≥ `floor` for certain.
     fn below(&mut self, i: usize, x: &P3, floor: f64) -> Option<(f64, V3)> {
-        let (at, phi, _) = self.last[i];
+        let (at, phi, grad) = self.last[i];
         if phi - 2.0 * (x - at).norm() >= floor {
             return None;
         }
+        // NEG_INFINITY: not evaluated yet (Φ is a distance, never −∞).
+        let same = |a: &P3, b: &P3| (0..3).all(|k| a[k].to_bits() == b[k].to_bits());
+        if self.reuse && phi > f64::NEG_INFINITY && same(x, &at) {
+            return (phi < floor).then_some((phi, grad));
+        }
         let (phi, grad) = self.field.eval(x);
+        self.evals += 1;
         self.last[i] = (*x, phi, grad);
         (phi < floor).then_some((phi, grad))
     }
@@ -146,9 +163,24 @@ pub fn refine(
     unit: f64,
     o: &RefineOptions,
 ) -> Refined {
+    refine_counted(points, target, init, field, unit, o, true).0
+}
+
+/// [`refine`] with its two exact shortcuts on or off (`reuse`: the field's reuse of an
+/// evaluation at the same point, and a line-search candidate refused as soon as its partial
+/// energy exceeds the current one), and the number of field evaluations it made.
+fn refine_counted(
+    points: &[P3],
+    target: &Target,
+    init: Similarity,
+    field: &AnchorField,
+    unit: f64,
+    o: &RefineOptions,
+    reuse: bool,
+) -> (Refined, usize) {
     let m0 = init.matrix();
     let start: Vec<P3> = points.iter().map(|p| m0.transform_point(p)).collect();
-    let mut lazy = LazyField::new(field, points.len());
+    let mut lazy = LazyField::new(field, points.len(), reuse);
     let before = lazy.max_penetration(points, &m0);
     let mut t = init;
     let eps = o.epsilon;
@@ -269,6 +301,12 @@ pub fn refine(
                 let mut e = data(&mm);
                 if beta > 0.0 {
                     for (i, p) in points.iter().enumerate() {
+                        // Every term is ≥ 0, so the rounded sum never decreases: once above e0
+                        // the candidate is refused whatever the remaining samples add, and they
+                        // are not evaluated.
+                        if reuse && e > e0 {
+                            break;
+                        }
                         if let Some((phi_u, _)) = lazy.below(i, &mm.transform_point(p), eps_u) {
                             e += beta * collision(phi_u);
                         }
@@ -302,13 +340,14 @@ pub fn refine(
         .zip(&start)
         .map(|(p, s)| (m.transform_point(p) - s).norm())
         .fold(0.0, f64::max);
-    Refined {
+    let refined = Refined {
         transform: t,
         penetration_before: before,
         penetration_after: lazy.max_penetration(points, &m),
         moved,
         continuation,
-    }
+    };
+    (refined, lazy.evals)
 }
 
 #[cfg(test)]
@@ -347,5 +386,44 @@ mod tests {
         assert!(c.x > 0.0995 && c.x < 0.1015, "{c:?}");
         assert!(c.y.abs() < 5e-4 && c.z.abs() < 5e-4, "{c:?}");
         assert!(out.moved < 0.0125, "{out:?}");
+    }
+
+    /// The shortcuts (reusing an evaluation at the same point; refusing a line-search
+    /// candidate once its partial energy is above the current one) change nothing, every field
+    /// of the result bit for bit, and save evaluations of the field.
+    #[test]
+    fn the_exact_shortcuts_change_nothing_and_save_evaluations() {
+        let r = 0.05;
+        let field = AnchorField::new(&[crate::shapes::uv_sphere(r, 32, 64)], 32);
+        let vis = crate::shapes::visual(
+            &crate::shapes::uv_sphere(r, 32, 64),
+            crate::shapes::UvProjection::Spherical { repeat: 1.0 },
+            Default::default(),
+        );
+        let pts = Cloud::sample(&vis, 1500, 5).points;
+        let o = RefineOptions::default();
+        for (x, tilt) in [(0.09, 0.0), (0.07, 0.4), (0.095, -1.1)] {
+            let init = Similarity {
+                scale: 1.0,
+                rotation: UnitQuaternion::from_euler_angles(tilt, 0.2 * tilt, 0.0),
+                translation: V3::new(x, 0.01, -0.005),
+            };
+            let (a, na) = refine_counted(&pts, &Target::InitialPose, init, &field, 0.2, &o, true);
+            let (b, nb) = refine_counted(&pts, &Target::InitialPose, init, &field, 0.2, &o, false);
+            let bits = |t: &Refined| {
+                let s = t.transform;
+                let mut v = vec![s.scale, t.penetration_before, t.penetration_after, t.moved];
+                v.extend(s.rotation.coords.iter());
+                v.extend(s.translation.iter());
+                v.iter().map(|x| x.to_bits()).collect::<Vec<u64>>()
+            };
+            assert_eq!(bits(&a), bits(&b), "start {x} {tilt}");
+            assert_eq!(a.continuation, b.continuation);
+            // The overlap is removed (the result is a real refinement, not a no-op) ...
+            assert!(a.penetration_before > 0.004, "{a:?}");
+            assert!(a.penetration_after <= o.tolerance * 0.2 + 1e-12, "{a:?}");
+            // ... with fewer evaluations of the field.
+            assert!(na < nb, "{na} vs {nb} evaluations");
+        }
     }
 }
