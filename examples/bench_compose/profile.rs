@@ -36,6 +36,38 @@ fn quantile(sorted: &[f64], q: f64) -> f64 {
     sorted[i.min(sorted.len() - 1)]
 }
 
+/// `points` binned along `axis` (unit) through `origin`: `bins` bins over the 0.5–99.5 % range
+/// of the axial coordinates, each point's offset from `origin` mapped by `f` into its bin.
+/// Returns (the first bin's start, the bin length, the bins); with no points, one unit-long bin
+/// start at 0 and empty bins.
+fn binned<T>(
+    points: &[P3],
+    origin: &P3,
+    axis: &V3,
+    bins: usize,
+    f: impl Fn(&V3) -> T,
+) -> (f64, f64, Vec<Vec<T>>) {
+    let bins = bins.max(1);
+    let mut members: Vec<Vec<T>> = (0..bins).map(|_| Vec::new()).collect();
+    let u: Vec<f64> = points.iter().map(|p| axis.dot(&(p - origin))).collect();
+    if u.is_empty() {
+        return (0.0, 1.0, members);
+    }
+    let mut s = u.clone();
+    s.sort_by(f64::total_cmp);
+    let cut = s.len() / 200;
+    let (lo, hi) = (s[cut], s[s.len() - 1 - cut]);
+    let bin = ((hi - lo) / bins as f64).max(f64::MIN_POSITIVE);
+    for (p, &ui) in points.iter().zip(&u) {
+        let k = ((ui - lo) / bin).floor();
+        if k < 0.0 || k >= bins as f64 {
+            continue;
+        }
+        members[k as usize].push(f(&(p - origin)));
+    }
+    (lo, bin, members)
+}
+
 impl Profile {
     /// The widths of `points` along `axis` (unit) through `origin`, in `bins` bins over the
     /// 0.5–99.5 % range of the axial coordinates. `across` are two unit vectors spanning the
@@ -43,29 +75,9 @@ impl Profile {
     /// [`DIRECTIONS`] directions in that plane (a cylinder seen from one side still shows its
     /// full diameter across the line of sight).
     pub fn along(points: &[P3], origin: &P3, axis: &V3, across: [V3; 2], bins: usize) -> Profile {
-        let bins = bins.max(1);
-        let u: Vec<f64> = points.iter().map(|p| axis.dot(&(p - origin))).collect();
-        if u.is_empty() {
-            return Profile {
-                lo: 0.0,
-                bin: 1.0,
-                width: vec![f64::NAN; bins],
-            };
-        }
-        let mut s = u.clone();
-        s.sort_by(f64::total_cmp);
-        let cut = s.len() / 200;
-        let (lo, hi) = (s[cut], s[s.len() - 1 - cut]);
-        let bin = ((hi - lo) / bins as f64).max(f64::MIN_POSITIVE);
-        let mut members: Vec<Vec<[f64; 2]>> = vec![Vec::new(); bins];
-        for (p, &ui) in points.iter().zip(&u) {
-            let k = ((ui - lo) / bin).floor();
-            if k < 0.0 || k >= bins as f64 {
-                continue;
-            }
-            let d = p - origin;
-            members[k as usize].push([across[0].dot(&d), across[1].dot(&d)]);
-        }
+        let (lo, bin, members) = binned(points, origin, axis, bins, |d| {
+            [across[0].dot(d), across[1].dot(d)]
+        });
         let width = members
             .iter()
             .map(|m| {
@@ -91,29 +103,9 @@ impl Profile {
     /// coordinates: a radius profile, robust to a minority of stray points in a bin (bleed onto
     /// the support lies off the axis).
     pub fn radial(points: &[P3], origin: &P3, axis: &V3, bins: usize, q: f64) -> Profile {
-        let bins = bins.max(1);
-        let u: Vec<f64> = points.iter().map(|p| axis.dot(&(p - origin))).collect();
-        if u.is_empty() {
-            return Profile {
-                lo: 0.0,
-                bin: 1.0,
-                width: vec![f64::NAN; bins],
-            };
-        }
-        let mut s = u.clone();
-        s.sort_by(f64::total_cmp);
-        let cut = s.len() / 200;
-        let (lo, hi) = (s[cut], s[s.len() - 1 - cut]);
-        let bin = ((hi - lo) / bins as f64).max(f64::MIN_POSITIVE);
-        let mut members: Vec<Vec<f64>> = vec![Vec::new(); bins];
-        for (p, &ui) in points.iter().zip(&u) {
-            let k = ((ui - lo) / bin).floor();
-            if k < 0.0 || k >= bins as f64 {
-                continue;
-            }
-            let d = p - origin;
-            members[k as usize].push((d - axis * axis.dot(&d)).norm());
-        }
+        let (lo, bin, mut members) = binned(points, origin, axis, bins, |d| {
+            (d - axis * axis.dot(d)).norm()
+        });
         let width = members
             .iter_mut()
             .map(|m| {

@@ -106,24 +106,19 @@ pub fn dump(inp: &ObjectInput, truth: &Similarity) {
     let g = Profile::along(&back, &ob.center, &ax, ac, 40);
     let gr = Profile::radial(&back, &ob.center, &ax, 40, 0.5);
     let d = oc.diagonal();
-    let row: Vec<String> = (0..40)
-        .map(|k| {
-            format!(
-                "{:.1}/{:.1}",
-                100.0 * model.width[k] / d,
-                100.0 * g.width[k] / d
-            )
-        })
-        .collect();
-    let rrow: Vec<String> = (0..40)
-        .map(|k| {
-            format!(
-                "{:.1}/{:.1}",
-                100.0 * model_r.width[k] / d,
-                100.0 * gr.width[k] / d
-            )
-        })
-        .collect();
+    // Bin k of both profiles, in % of the diagonal: "model/guidance".
+    let row = |m: &Profile, g: &Profile| -> Vec<String> {
+        (0..40)
+            .map(|k| {
+                format!(
+                    "{:.1}/{:.1}",
+                    100.0 * m.width[k] / d,
+                    100.0 * g.width[k] / d
+                )
+            })
+            .collect()
+    };
+    let (row, rrow) = (row(&model, &g), row(&model_r, &gr));
     eprintln!(
         "  model/guidance radius (% diag), lo {:+.1} vs {:+.1}: {}",
         100.0 * gr.lo / d,

@@ -542,35 +542,38 @@ pub fn run(args: &[String]) {
     } else {
         slowest.len().min(10)
     };
-    println!(
-        "\n#### The slowest pairs ({} of {}; s of `compose` a pair, CPU on one thread, else wall)\n",
-        n_slow,
-        slowest.len()
-    );
-    println!("| s | pair | seed | support | item | support tris (guidance) | item tris (guidance) | support texture | item texture |");
-    println!("|---:|---:|---:|---|---|---:|---:|---:|---:|");
-    let tex = |t: (u32, u32)| {
-        if t.0 == 0 {
-            "-".to_string()
-        } else {
-            format!("{}×{}", t.0, t.1)
-        }
-    };
-    for &(k, s) in &slowest[..n_slow] {
-        let [a, b] = s.sizes;
+    // A run that composed nothing (`--profile-probe`) has no pairs to list.
+    if !slowest.is_empty() {
         println!(
-            "| {:.2} | {k} | {} | {} | {} | {} ({}) | {} ({}) | {} | {} |",
-            s.secs,
-            s.seed,
-            PAIRS[k].0,
-            PAIRS[k].1,
-            a.tris,
-            a.guidance_tris,
-            b.tris,
-            b.guidance_tris,
-            tex(a.texture),
-            tex(b.texture)
+            "\n#### The slowest pairs ({} of {}; s of `compose` a pair, CPU on one thread, else wall)\n",
+            n_slow,
+            slowest.len()
         );
+        println!("| s | pair | seed | support | item | support tris (guidance) | item tris (guidance) | support texture | item texture |");
+        println!("|---:|---:|---:|---|---|---:|---:|---:|---:|");
+        let tex = |t: (u32, u32)| {
+            if t.0 == 0 {
+                "-".to_string()
+            } else {
+                format!("{}×{}", t.0, t.1)
+            }
+        };
+        for &(k, s) in &slowest[..n_slow] {
+            let [a, b] = s.sizes;
+            println!(
+                "| {:.2} | {k} | {} | {} | {} | {} ({}) | {} ({}) | {} | {} |",
+                s.secs,
+                s.seed,
+                PAIRS[k].0,
+                PAIRS[k].1,
+                a.tris,
+                a.guidance_tris,
+                b.tris,
+                b.guidance_tris,
+                tex(a.texture),
+                tex(b.texture)
+            );
+        }
     }
     println!(
         "\n{} compose calls, {} thread(s) each, {} job(s), total {:.1} s",
