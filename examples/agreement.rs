@@ -18,6 +18,8 @@
 //! `INTERACT3D_PYTHON`, default `python3`). Objects are decomposed once each and cached in
 //! `target/agreement-cache`.
 
+#[path = "common/seeds.rs"]
+mod seeds;
 use interact3d::agreement::nudge::{self, Spread};
 use interact3d::agreement::{
     judge::judge_with, run_scene_with, summary, Catalog, Generated, Judged, Summary,
@@ -42,11 +44,7 @@ fn main() {
     let mut args = std::env::args().skip(1);
     while let Some(a) = args.next() {
         match a.as_str() {
-            "--seeds" => {
-                let v = args.next().expect("--seeds A..B");
-                let (a, b) = v.split_once("..").expect("--seeds A..B");
-                seeds = a.parse().expect("seed")..b.parse().expect("seed");
-            }
+            "--seeds" => seeds = seeds::seed_range(&args.next().expect("--seeds A..B")),
             "--out" => out = args.next().expect("--out DIR").into(),
             "--objects" => objects = args.next().expect("--objects DIR").into(),
             "--batch" => batch = args.next().expect("--batch N").parse().expect("N"),

@@ -11,6 +11,8 @@
 //! Run: `nice cargo run --release --example verdict_signals -- [--seeds 0..700] [--out FILE]
 //!       [--nudge-seeds FILE]` (one JSON line a scene, in seed order per batch).
 
+#[path = "common/seeds.rs"]
+mod seeds;
 use interact3d::agreement::Catalog;
 use interact3d::physics::SettleOptions;
 use interact3d::validate::nudge::{nudged_verdicts, Starts};
@@ -25,11 +27,7 @@ fn main() {
     let mut args = std::env::args().skip(1);
     while let Some(a) = args.next() {
         match a.as_str() {
-            "--seeds" => {
-                let v = args.next().expect("--seeds A..B");
-                let (a, b) = v.split_once("..").expect("--seeds A..B");
-                seeds = a.parse().expect("seed")..b.parse().expect("seed");
-            }
+            "--seeds" => seeds = seeds::seed_range(&args.next().expect("--seeds A..B")),
             "--out" => out = args.next().expect("--out FILE").into(),
             "--nudge-seeds" => {
                 let f = args.next().expect("--nudge-seeds FILE");
