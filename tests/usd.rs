@@ -284,8 +284,9 @@ fn judge(scene: &Path, extra: &[&str]) -> (serde_json::Value, serde_json::Value)
 }
 
 /// Every body has `PhysxRigidBodyAPI` with the settle's damping and depenetration speed, every
-/// hull and the ground `PhysxCollisionAPI` with rest offset 0 (and PhysX's own contact offset), every material `PhysxMaterialAPI` averaging
-/// friction as Rapier does, and the ground has the settle's floor friction.
+/// hull and the ground `PhysxCollisionAPI` with rest offset 0 (and PhysX's own contact
+/// offset), every material `PhysxMaterialAPI` averaging friction as Rapier does, and the
+/// ground has the settle's floor friction.
 fn physx_settings_are_the_settles(
     u: &serde_json::Value,
     objects: &[serde_json::Value],
@@ -305,21 +306,16 @@ fn physx_settings_are_the_settles(
     assert_eq!(bodies.len(), objects.len(), "{what}: {:?}", bodies);
     for (p, r) in &bodies {
         let a = &r["attrs"];
-        assert!(
-            near(&a["physxRigidBody:angularDamping"], o.angular_damping),
-            "{what}: {p}: {a}"
-        );
-        assert!(
-            near(&a["physxRigidBody:linearDamping"], o.linear_damping),
-            "{what}: {p}: {a}"
-        );
-        assert!(
-            near(
-                &a["physxRigidBody:maxDepenetrationVelocity"],
-                o.max_corrective_velocity
+        for (k, want) in [
+            ("physxRigidBody:angularDamping", o.angular_damping),
+            ("physxRigidBody:linearDamping", o.linear_damping),
+            (
+                "physxRigidBody:maxDepenetrationVelocity",
+                o.max_corrective_velocity,
             ),
-            "{what}: {p}: {a}"
-        );
+        ] {
+            assert!(near(&a[k], want), "{what}: {p}: {k}: {a}");
+        }
     }
     let hulls: u64 = objects
         .iter()
@@ -356,14 +352,9 @@ fn physx_settings_are_the_settles(
         );
     }
     let ground = &authored["/World/Ground/PhysicsMaterial"]["attrs"];
-    assert!(
-        near(&ground["physics:staticFriction"], o.floor_friction),
-        "{what}: {ground}"
-    );
-    assert!(
-        near(&ground["physics:dynamicFriction"], o.floor_friction),
-        "{what}: {ground}"
-    );
+    for k in ["physics:staticFriction", "physics:dynamicFriction"] {
+        assert!(near(&ground[k], o.floor_friction), "{what}: {k}: {ground}");
+    }
 }
 
 #[test]
