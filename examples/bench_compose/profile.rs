@@ -208,6 +208,22 @@ pub struct FitOptions {
     pub contrast_gap: f64,
 }
 
+impl FitOptions {
+    /// `steps` scales within ×/÷ 1.5 of `scale`, width offsets up to 3 % of the scaled
+    /// diagonal `diag`, the best-fitting 80 % of the bins kept, rivals counted from 5 % away:
+    /// the probe's search around the bounding-box scale.
+    pub fn around(scale: f64, diag: f64, steps: usize) -> FitOptions {
+        FitOptions {
+            scale_lo: scale / 1.5,
+            scale_hi: scale * 1.5,
+            steps,
+            widen_max: 0.03 * diag * scale,
+            keep: 0.8,
+            contrast_gap: 0.05,
+        }
+    }
+}
+
 /// The cost of mapping `model` onto `guidance` by v = b + sign·k·u, with the width offset
 /// fitted (median, clamped to ±`widen_max`); returns (cost, widen).
 fn cost(
@@ -364,14 +380,7 @@ mod tests {
             let holes = [(0.88, 1.0), (0.15, 0.27)];
             let g = stepped(6000, k, 0.37, &holes, 0.003 * diag * k, seed);
             let gp = bar_profile(&g, 60);
-            let o = FitOptions {
-                scale_lo: k / 1.5,
-                scale_hi: k * 1.5,
-                steps: 81,
-                widen_max: 0.03 * diag * k,
-                keep: 0.8,
-                contrast_gap: 0.05,
-            };
+            let o = FitOptions::around(k, diag, 81);
             let f = fit(&model, &gp, &o).unwrap();
             let err = f.scale / k - 1.0;
             assert!(err.abs() < 0.03, "k {k}: profile scale error {err}");

@@ -27,14 +27,7 @@ pub fn print(id: &str, seed: u64, inp: &ObjectInput, truth: &Similarity) {
     let gb = Obb::of_points(&gc.points);
     let s0 = interact3d::compose::obb::scale_ratio(&ob, &gb);
     let diag = oc.diagonal();
-    let o = FitOptions {
-        scale_lo: s0 / 1.5,
-        scale_hi: s0 * 1.5,
-        steps: 121,
-        widen_max: 0.03 * diag * s0,
-        keep: 0.8,
-        contrast_gap: 0.05,
-    };
+    let o = FitOptions::around(s0, diag, 121);
     let rel = |s: f64| 100.0 * (s / truth.scale - 1.0);
     let show = |f: Option<ProfileFit>| {
         f.map_or("none".to_string(), |f| {
