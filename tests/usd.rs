@@ -446,3 +446,127 @@ fn newton_imports_the_files() {
         assert_eq!(one["collision_shapes"], o["hull_count"], "{name}: {n}");
     }
 }
+
+/// An axis-aligned box of extents `e` (m) centred at the origin, as OBJ text.
+fn box_obj(e: [f64; 3]) -> String {
+    let h = e.map(|x| x / 2.0);
+    let mut obj = String::new();
+    for x in [-h[0], h[0]] {
+        for y in [-h[1], h[1]] {
+            for z in [-h[2], h[2]] {
+                obj += &format!("v {x} {y} {z}\n");
+            }
+        }
+    }
+    // Vertex k + 1 has x = k & 4, y = k & 2, z = k & 1 (set = +h); faces wound outwards.
+    for t in [
+        [1, 3, 4],
+        [1, 4, 2],
+        [5, 6, 8],
+        [5, 8, 7],
+        [1, 2, 6],
+        [1, 6, 5],
+        [3, 7, 8],
+        [3, 8, 4],
+        [1, 5, 7],
+        [1, 7, 3],
+        [2, 4, 8],
+        [2, 8, 6],
+    ] {
+        obj += &format!("f {} {} {}\n", t[0], t[1], t[2]);
+    }
+    obj
+}
+
+/// A heavily loaded body (one carrying at least `SettleOptions::load_ratio` times its own mass)
+/// carries PhysX solver iterations in its USD; every other body keeps PhysX's own. Two box
+/// stacks written here as our manifest, 0.4 m apart, each upper box 0.1 mm above the lower:
+/// a 3 cm cube of 27 g under a 10 × 10 × 5 cm box of 1 kg (37×, loaded), and a 6 cm cube of
+/// 108 g under a 0.5 kg box (4.6×, not). The masses, and so which body is loaded, are computed
+/// here from the boxes' volumes and densities; PhysX then holds both stacks where our settle
+/// left them (1 mm, 1° over 2 s).
+#[test]
+fn loaded_bodies_carry_the_loaded_solver_iterations() {
+    let tmp = tempfile::tempdir().unwrap();
+    let scene = tmp.path().join("scene");
+    std::fs::create_dir_all(scene.join("meshes")).unwrap();
+    let gap = 1e-4;
+    // (name, extents, density, x, bottom)
+    let boxes: [(&str, [f64; 3], f64, f64, f64); 4] = [
+        ("dice", [0.03, 0.03, 0.03], 1000.0, 0.0, 0.0),
+        ("brick", [0.1, 0.1, 0.05], 2000.0, 0.0, 0.03 + gap),
+        ("pad", [0.06, 0.06, 0.06], 500.0, 0.4, 0.0),
+        ("weight", [0.1, 0.1, 0.05], 1000.0, 0.4, 0.06 + gap),
+    ];
+    let mut objects = Vec::new();
+    for (name, e, density, x, bottom) in boxes {
+        std::fs::write(scene.join(format!("meshes/{name}.obj")), box_obj(e)).unwrap();
+        objects.push(serde_json::json!({
+            "name": name,
+            "mesh": format!("meshes/{name}.obj"),
+            "label": name,
+            "pose": {
+                "translation": [x, 0.0, bottom + e[2] / 2.0],
+                "quaternion_wxyz": [1.0, 0.0, 0.0, 0.0],
+                "scale": 1.0
+            },
+            "density": density,
+        }));
+    }
+    let manifest = serde_json::json!({
+        "format": "interact3d-scene",
+        "version": 1,
+        "name": "stacks",
+        "units": "m",
+        "up_axis": "z",
+        "objects": objects,
+    });
+    std::fs::write(
+        scene.join("scene.json"),
+        serde_json::to_string_pretty(&manifest).unwrap(),
+    )
+    .unwrap();
+    let mass = |k: usize| boxes[k].1.iter().product::<f64>() * boxes[k].2;
+    let o = interact3d::physics::SettleOptions::default();
+    let loaded_by_hand = [
+        mass(1) >= o.load_ratio * mass(0),
+        false,
+        mass(3) >= o.load_ratio * mass(2),
+        false,
+    ];
+    assert_eq!(loaded_by_hand, [true, false, false, false]);
+
+    let (report, u) = judge(&scene, ISAAC);
+    assert_eq!(
+        report["validation"]["passed"], true,
+        "both stacks stand: {}",
+        report["validation"]
+    );
+    // PhysX's own 16 position iterations times the settle's biased sweeps of a loaded island
+    // over an unloaded one's (8 substeps × 4 sweeps against 4 × 1: 128); velocity PhysX's 1.
+    let pos = 16 * (o.loaded_solver_iterations * o.loaded_pgs_iterations)
+        / (o.solver_iterations * o.pgs_iterations);
+    let vel = 1;
+    assert_eq!(pos, 128, "the default settle's loaded island");
+    assert_eq!(
+        interact3d::export::usd::loaded_iterations(&o),
+        (pos as u32, vel)
+    );
+    let authored = u["physx_authored"].as_object().unwrap();
+    for (k, (name, ..)) in boxes.iter().enumerate() {
+        let a = &authored[&format!("/World/{name}")]["attrs"];
+        let counts = (
+            a.get("physxRigidBody:solverPositionIterationCount"),
+            a.get("physxRigidBody:solverVelocityIterationCount"),
+        );
+        if loaded_by_hand[k] {
+            assert_eq!(
+                (counts.0.map(f), counts.1.map(f)),
+                (Some(pos as f64), Some(vel as f64)),
+                "{name}: {a}"
+            );
+        } else {
+            assert_eq!(counts, (None, None), "{name}: {a}");
+        }
+    }
+}

@@ -88,12 +88,34 @@ fn write_all(
             // The USD says what the settle test assumed (export follows validation with the
             // default options); the MJCF keeps its own floor (MuJoCo takes the larger friction).
             let physx = usd::PhysxCtx::from_settle(&crate::physics::SettleOptions::default());
-            usd::write_usd(assembly, &body_files, dir, templates, &physx)
+            usd::write_usd(
+                assembly,
+                &body_files,
+                dir,
+                templates,
+                &physx,
+                &heavily_loaded(report),
+            )
         },
         || write_mjcf_urdf_json(assembly, report, dir, templates, &ctx_bodies),
     );
     usd?;
     rest
+}
+
+/// The bodies the validation's settle marked heavily loaded (`validation.settle.heavily_loaded`
+/// of the report); none when the scene was not validated.
+fn heavily_loaded(report: &Report) -> Vec<String> {
+    report
+        .validation
+        .as_ref()
+        .and_then(|v| v["settle"]["heavily_loaded"].as_array())
+        .map(|a| {
+            a.iter()
+                .filter_map(|n| n.as_str().map(String::from))
+                .collect()
+        })
+        .unwrap_or_default()
 }
 
 /// `scene.xml`, each body's `.xml` and `.urdf`, `scene.json` and `report.json`.
