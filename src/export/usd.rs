@@ -114,9 +114,13 @@ pub const PHYSX_VELOCITY_ITERATIONS: u32 = 1;
 /// largest count of its bodies, as Rapier adds a loaded body's extra iterations to its
 /// island, so the count on the loaded body alone reaches the whole stack.
 pub fn loaded_iterations(o: &SettleOptions) -> (u32, u32) {
-    let sweeps = |substeps: usize, pgs: usize| (substeps * pgs).max(1) as f64;
-    let ratio = sweeps(o.loaded_solver_iterations, o.loaded_pgs_iterations)
-        / sweeps(o.solver_iterations, o.pgs_iterations);
+    // A loaded island runs at least the world's substeps and sweeps (`load_extra_iterations`
+    // adds only what is missing).
+    let own = (o.solver_iterations * o.pgs_iterations).max(1) as f64;
+    let loaded = (o.loaded_solver_iterations.max(o.solver_iterations)
+        * o.loaded_pgs_iterations.max(o.pgs_iterations))
+    .max(1) as f64;
+    let ratio = loaded / own;
     let pos = (PHYSX_POSITION_ITERATIONS as f64 * ratio).round() as u32;
     (
         pos.clamp(PHYSX_POSITION_ITERATIONS, 255),
@@ -486,6 +490,28 @@ mod tests {
         let i = r * cyl * r.transpose();
         let (d, q) = principal_axes(&i);
         assert!((rebuilt(&d, &q) - i).norm() < 1e-12 * i.norm());
+    }
+
+    #[test]
+    fn loaded_iterations_scale_physx_by_the_settles_sweeps() {
+        // The default settle: 8 × 4 biased sweeps against 4 × 1, so 16 × 8.
+        assert_eq!(loaded_iterations(&SettleOptions::default()), (128, 1));
+        let o = |sub, pgs, lsub, lpgs| SettleOptions {
+            solver_iterations: sub,
+            pgs_iterations: pgs,
+            loaded_solver_iterations: lsub,
+            loaded_pgs_iterations: lpgs,
+            ..Default::default()
+        };
+        // 6 × 2 against 4 × 1: 16 × 3.
+        assert_eq!(loaded_iterations(&o(4, 1, 6, 2)), (48, 1));
+        // No extra sweeps (or fewer, which the settle raises to its own): PhysX's own 16.
+        assert_eq!(loaded_iterations(&o(4, 1, 4, 1)), (16, 1));
+        assert_eq!(loaded_iterations(&o(4, 2, 2, 1)), (16, 1));
+        // Each count raised to the world's on its own: 4 substeps × 4 sweeps against 4 × 1.
+        assert_eq!(loaded_iterations(&o(4, 1, 2, 4)), (64, 1));
+        // PhysX takes at most 255.
+        assert_eq!(loaded_iterations(&o(1, 1, 64, 64)), (255, 1));
     }
 
     #[test]
