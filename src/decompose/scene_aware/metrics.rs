@@ -23,7 +23,6 @@
 use super::geom::{components, sample_hull, Surface};
 use crate::decompose::Hull;
 use crate::mesh::{Aabb, Mesh, P3, V3};
-use pieces::Pieces;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
@@ -48,7 +47,10 @@ pub const TWO_SIDED_SAMPLES: usize = 6000;
 /// Both directions with about `n` samples on each side; `None` without mesh or hull surface.
 pub fn two_sided(s: &Surface, hulls: &[Hull], n: usize) -> Option<TwoSided> {
     let fwd = surface_distances(s, hulls, n);
-    let boundary = union_boundary(hulls, s.diag)?;
+    let boundary = UnionFaces::new(hulls, s.diag);
+    if boundary.is_empty() {
+        return None;
+    }
     let pts = seen_samples(s, n);
     if fwd.is_empty() || pts.is_empty() {
         return None;
@@ -76,7 +78,10 @@ pub fn two_sided(s: &Surface, hulls: &[Hull], n: usize) -> Option<TwoSided> {
 /// Distances (relative to the diagonal) from about `n` points on the mesh surface to the
 /// boundary of the union of the hulls; `None` without hull surface.
 pub fn mesh_to_hull_distances(s: &Surface, hulls: &[Hull], n: usize) -> Option<Vec<f64>> {
-    let boundary = union_boundary(hulls, s.diag)?;
+    let boundary = UnionFaces::new(hulls, s.diag);
+    if boundary.is_empty() {
+        return None;
+    }
     Some(
         seen_samples(s, n)
             .par_iter()
@@ -209,39 +214,7 @@ pub fn percentile(d: &[f64], q: f64) -> f64 {
 /// pieces of its six boxes, read 3.6 % of the diagonal mesh → hulls at the 95th percentile
 /// (8.6 % at most) from such holes alone, where they fill every box exactly.
 pub fn union_boundary(hulls: &[Hull], diag: f64) -> Option<Surface> {
-    let eps = 1e-6 * diag;
-    let tris: Vec<Vec<[P3; 3]>> = hulls
-        .par_iter()
-        .enumerate()
-        .map(|(i, h)| {
-            let others: Vec<(usize, &Hull)> = hulls
-                .iter()
-                .enumerate()
-                .filter(|&(j, g)| j != i && g.aabb.intersects(&h.aabb, eps))
-                .collect();
-            let mut out = Vec::new();
-            let mut pieces = Pieces::default();
-            for t in &h.triangles {
-                let tri = t.map(|k| h.vertices[k as usize]);
-                pieces.outside(tri, &others, i, eps, |poly| {
-                    for k in 1..poly.len() - 1 {
-                        let tri = [poly[0], poly[k], poly[k + 1]];
-                        if (tri[1] - tri[0]).cross(&(tri[2] - tri[0])).norm() > 0.0 {
-                            out.push(tri);
-                        }
-                    }
-                });
-            }
-            out
-        })
-        .collect();
-    let mut mesh = Mesh::default();
-    for t in tris.into_iter().flatten() {
-        let k = mesh.vertices.len() as u32;
-        mesh.vertices.extend(t);
-        mesh.triangles.push([k, k + 1, k + 2]);
-    }
-    Surface::new(&mesh)
+    Surface::new(&UnionFaces::new(hulls, diag).mesh())
 }
 
 /// Measured quality of a set of hulls for one mesh.
@@ -428,5 +401,7 @@ pub fn cavity_probe(s: &Surface) -> Option<P3> {
 }
 
 mod pieces;
+mod union;
+pub use union::UnionFaces;
 #[cfg(test)]
 mod tests;

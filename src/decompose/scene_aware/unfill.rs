@@ -26,7 +26,7 @@
 //! moves again may be kept. Other objects take the face-plane path as before, bit for bit.
 
 use super::geom::Surface;
-use super::metrics;
+use super::metrics::{self, UnionFaces};
 use super::object::{distance_stats, hulls_of};
 use super::patches::Features;
 use super::rebalance::{adjacency, adjacent_pairs, build_merge, lift, pinned};
@@ -53,11 +53,12 @@ const OUTSIDE: f64 = 0.6;
 const MERGES: usize = 5;
 /// Union-boundary checks an object is allowed: one per [`CHECK_STEP`] of the diagonal by which
 /// its mesh → hulls side (to the union's boundary) exceeds its hull → mesh side, within
-/// [`MIN_CHECKS`]..=[`MAX_CHECKS`]. Each check builds the boundary of the union of all the
-/// object's hulls (about 0.1 CPU-s on 32 hulls), and the objects with most to gain are where
-/// kept moves were found: TROCHILUS (2.6 points between the sides) keeps its sixth move at the
-/// 11th check, while the Reebok shoes (0.4 points) kept one or two moves in 25 and 34 checks
-/// that gained 0.01–0.04 points.
+/// [`MIN_CHECKS`]..=[`MAX_CHECKS`]. Each check measures against the boundary of the union of
+/// all the object's hulls (about 0.1 CPU-s on 32 hulls when built whole; since session 16 only
+/// the faces the move's hulls reach are cut again, [`UnionFaces::moved`]), and the objects with
+/// most to gain are where kept moves were found: TROCHILUS (2.6 points between the sides) keeps
+/// its sixth move at the 11th check, while the Reebok shoes (0.4 points) kept one or two moves
+/// in 25 and 34 checks that gained 0.01–0.04 points.
 const CHECK_STEP: f64 = 0.002;
 const MIN_CHECKS: usize = 2;
 const MAX_CHECKS: usize = 12;
@@ -106,21 +107,61 @@ fn held_cuts(
     cuts
 }
 
-/// Mesh → hulls 95th percentile of `parts` (fraction of the diagonal) on `pts`, to the
-/// boundary of the union of the hulls as the bench and the report measure it. The face-plane
-/// depth of [`back_and_out`] is a lower bound of it that two overlapping halves of a filling
-/// hull fool: each holds the cavity less deep while their union fills it as before (a cut
-/// through TROCHILUS's cavity read 0.4 points better by face planes and measured 0.4 points
-/// worse, Session 10 of `docs/collision_fit.md`).
-fn back_to_union(s: &Surface, parts: &[Part], pts: &[P3]) -> f64 {
-    let Some(boundary) = metrics::union_boundary(&hulls_of(parts), s.diag) else {
+/// Mesh → hulls 95th percentile (fraction of the diagonal) of `pts` to `u`, the boundary of
+/// the union of the hulls as the bench and the report measure it; infinite without one. The
+/// face-plane depth of [`back_and_out`] is a lower bound of it that two overlapping halves of
+/// a filling hull fool: each holds the cavity less deep while their union fills it as before
+/// (a cut through TROCHILUS's cavity read 0.4 points better by face planes and measured 0.4
+/// points worse, Session 10 of `docs/collision_fit.md`).
+fn union_p95(s: &Surface, u: &UnionFaces, pts: &[P3]) -> f64 {
+    if u.is_empty() {
         return f64::INFINITY;
-    };
-    let d: Vec<f64> = pts
-        .par_iter()
-        .map(|p| boundary.distance(p) / s.diag)
-        .collect();
+    }
+    let d: Vec<f64> = pts.par_iter().map(|p| u.distance(p) / s.diag).collect();
     metrics::percentile(&d, 0.95)
+}
+
+/// [`union_p95`] of the hulls of `parts`, the boundary built anew.
+#[cfg(test)]
+fn back_to_union(s: &Surface, parts: &[Part], pts: &[P3]) -> f64 {
+    union_p95(s, &UnionFaces::new(&hulls_of(parts), s.diag), pts)
+}
+
+/// The union boundary of `next`: `parts` with `w`, `i` and `j` left out, in order, then three
+/// new parts, made from `u` (that of `parts`) by recutting only the faces the six hulls reach
+/// ([`UnionFaces::moved`]). Under `cfg(test)` it is checked against the boundary built anew,
+/// triangle for triangle to the bit.
+fn union_moved(
+    s: &Surface,
+    u: &UnionFaces,
+    parts: &[Part],
+    next: &[Part],
+    gone: [usize; 3],
+) -> UnionFaces {
+    let from: Vec<Option<usize>> = (0..parts.len())
+        .filter(|k| !gone.contains(k))
+        .map(Some)
+        .chain(std::iter::repeat(None))
+        .take(next.len())
+        .collect();
+    let hulls = hulls_of(next);
+    let moved = u.moved(&hulls, &from);
+    if cfg!(test) {
+        let bits = |m: &crate::mesh::Mesh| {
+            let v: Vec<[u64; 3]> = m
+                .vertices
+                .iter()
+                .map(|p| [p.x, p.y, p.z].map(f64::to_bits))
+                .collect();
+            (v, m.triangles.clone())
+        };
+        assert_eq!(
+            bits(&moved.mesh()),
+            bits(&UnionFaces::new(&hulls, s.diag).mesh()),
+            "the union boundary recut in part is the one built anew"
+        );
+    }
+    moved
 }
 
 /// Sum of the depths of the samples deeper than `deep` inside `h` (m).
@@ -214,6 +255,8 @@ pub(super) fn unfill(
     // Whether the union measure of `parts` was taken (at the first move that passes the face
     // planes), and the union checks left (see [`union_checks`]).
     let mut union_measured = false;
+    // The union boundary of `parts` once measured, and the one of each move checked against it.
+    let mut union: Option<UnionFaces> = None;
     let mut checks = 0;
     let mut stuck = vec![false; parts.len()];
     let mut kept = 0;
@@ -298,7 +341,9 @@ pub(super) fn unfill(
             // The union measure of `parts` once a move reaches this point (objects whose
             // splits or merges all fail above never pay for it), and the checks it allows.
             if union_mode && !union_measured {
-                let u = back_to_union(s, parts, &pts);
+                let b = UnionFaces::new(&hulls_of(parts), s.diag);
+                let u = union_p95(s, &b, &pts);
+                union = Some(b);
                 union_measured = true;
                 est = h2m_p95.max(u);
                 checks = union_checks(u - h2m_p95);
@@ -307,26 +352,28 @@ pub(super) fn unfill(
             if mb >= est - MIN_GAIN || o > out.max(OUTSIDE * p.tol / s.diag) {
                 continue;
             }
-            let mb = if union_mode {
+            let (mb, next_union) = if union_mode {
                 if checks == 0 {
                     break;
                 }
                 checks -= 1;
-                let mb = back_to_union(s, &next, &pts);
+                let u = union.as_ref().expect("measured above");
+                let b = union_moved(s, u, parts, &next, [w, i, j]);
+                let mb = union_p95(s, &b, &pts);
                 if mb >= est - MIN_GAIN {
                     continue;
                 }
-                mb
+                (mb, Some(b))
             } else {
-                mb
+                (mb, None)
             };
             let e = h2m(s, &next).max(mb);
             if e < est - MIN_GAIN {
-                found = Some((next, next_fill, e, o, i, j));
+                found = Some((next, next_fill, e, o, i, j, next_union));
                 break;
             }
         }
-        if let Some((next, next_fill, e, o, i, j)) = found {
+        if let Some((next, next_fill, e, o, i, j, next_union)) = found {
             let mut st: Vec<bool> = (0..parts.len())
                 .filter(|&k| k != w && k != i && k != j)
                 .map(|k| stuck[k])
@@ -334,6 +381,9 @@ pub(super) fn unfill(
             st.extend([false, false, false]);
             *parts = next;
             fills = next_fill;
+            if next_union.is_some() {
+                union = next_union;
+            }
             stuck = st;
             (est, out) = (e, o);
             kept += 1;
