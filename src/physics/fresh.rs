@@ -13,6 +13,15 @@
 //! interpenetration (see [`stale`]), the manifold is marked deformed and parry computes it
 //! from the current poses, the deepest point among its points. The package rests within
 //! 0.01 mm of the floor and of the box; the settle benchmark runs as fast as before.
+//!
+//! parry also keeps the manifold's **normal** while it turned less than 1°: the normal is stored
+//! in each shape's frame, so a body rocking on a rim pushes along a normal that turns with it,
+//! up to 1° off the floor's, a force that follows the body and does work on it. A 32-sided
+//! cylinder released tilted 4° on the floor rocks itself up to 7.3° in 4 s that way (seed 313's
+//! bottle, docs/agreement.md "Twelfth stop"). [`Fresh::max_turn_cos`] recomputes a manifold
+//! whose normal turned more than
+//! [`SettleOptions::contact_reuse_max_turn_deg`](super::SettleOptions::contact_reuse_max_turn_deg)
+//! since it was computed; at parry's own 1° nothing changes.
 
 use rapier3d_f64::geometry::{ContactData, ContactManifoldData};
 use rapier3d_f64::math::{Pose, Real, Vector};
@@ -25,8 +34,33 @@ use rapier3d_f64::parry::query::{
 use rapier3d_f64::parry::shape::Shape;
 
 /// parry's default dispatcher, but contact points kept from the last step are recomputed
-/// when they miss the deepest interpenetration (see [`stale`]).
-pub(super) struct Fresh;
+/// when they miss the deepest interpenetration (see [`stale`]) or when the manifold's normal
+/// turned more than `acos(max_turn_cos)` since it was computed.
+pub(super) struct Fresh {
+    /// Cosine of the largest turn of a kept normal; `None`: parry's own 1° decides.
+    pub(super) max_turn_cos: Option<Real>,
+}
+
+impl Fresh {
+    /// The dispatcher for a kept normal's largest turn `deg` (degrees); at 1° or more parry's
+    /// own check (1°) is the only one.
+    pub(super) fn new(deg: Real) -> Self {
+        Fresh {
+            max_turn_cos: (deg < 1.0).then(|| deg.to_radians().cos()),
+        }
+    }
+
+    /// [`stale`], or the normal kept in `m` turned more than the limit.
+    fn stale(&self, pos12: &Pose, g1: &dyn Shape, g2: &dyn Shape, m: &Manifold) -> bool {
+        if let Some(c) = self.max_turn_cos {
+            // parry's own coherence test (`try_update_contacts_eps`), with our angle.
+            if !m.points.is_empty() && -m.local_n1.dot(pos12.rotation * m.local_n2) < c {
+                return true;
+            }
+        }
+        stale(pos12, g1, g2, m)
+    }
+}
 
 type Manifold = ContactManifold<ContactManifoldData, ContactData>;
 
@@ -140,7 +174,7 @@ impl PersistentQueryDispatcher<ContactManifoldData, ContactData> for Fresh {
         workspace: &mut Option<ContactManifoldsWorkspace>,
     ) -> Result<(), Unsupported> {
         for m in manifolds.iter_mut() {
-            if stale(pos12, g1, g2, m) {
+            if self.stale(pos12, g1, g2, m) {
                 m.mark_shapes_deformed();
             }
         }
@@ -157,7 +191,7 @@ impl PersistentQueryDispatcher<ContactManifoldData, ContactData> for Fresh {
         prediction: Real,
         manifold: &mut Manifold,
     ) -> Result<(), Unsupported> {
-        if stale(pos12, g1, g2, manifold) {
+        if self.stale(pos12, g1, g2, manifold) {
             manifold.mark_shapes_deformed();
         }
         DefaultQueryDispatcher.contact_manifold_convex_convex(

@@ -115,7 +115,8 @@ impl<'a> Sim<'a> {
     ) -> Result<Self, PhysicsError> {
         validate_options(opts)?;
         let mut world = PhysicsWorld::new();
-        world.narrow_phase = NarrowPhase::with_query_dispatcher(fresh::Fresh);
+        world.narrow_phase =
+            NarrowPhase::with_query_dispatcher(fresh::Fresh::new(opts.contact_reuse_max_turn_deg));
         world.gravity = Vector::new(0.0, 0.0, -opts.gravity);
         let ip = &mut world.integration_parameters;
         ip.dt = opts.dt;
@@ -450,6 +451,7 @@ pub(super) fn validate_options(o: &SettleOptions) -> Result<(), PhysicsError> {
         ("contact_damping_ratio", o.contact_damping_ratio),
         ("linear_damping", o.linear_damping),
         ("prediction_distance", o.prediction_distance),
+        ("contact_reuse_max_turn_deg", o.contact_reuse_max_turn_deg),
         ("contact_recycle_distance", o.contact_recycle_distance),
         ("angular_damping", o.angular_damping),
         ("perturbation_speed", o.perturbation_speed),
