@@ -1,7 +1,7 @@
 //! Closed-form similarity (Umeyama 1991) with a bounded scale, and scale-aware trimmed ICP.
 
 use super::cloud::Cloud;
-use super::kdtree::{KdTree, KdTreeN};
+use super::kdtree::{KdTree, KdTreeN, Warm};
 use crate::mesh::{P3, V3};
 use crate::pose::Similarity;
 use nalgebra::{Matrix3, Rotation3, UnitQuaternion};
@@ -106,6 +106,25 @@ impl<'a> Matcher<'a> {
             ),
         }
     }
+
+    /// [`Self::nearest`] of a guidance point asked again at every ICP iteration, each time a
+    /// little moved: the same answer, often without a search (see [`KdTreeN::nearest_warm_n`]).
+    pub fn nearest_warm(&self, q: &P3, colour: &[f64; 3], warm: &mut Warm) -> Option<(usize, f64)> {
+        match self {
+            Matcher::Geometry(t) => t.nearest_warm(q, warm),
+            Matcher::Colour { tree, weight } => tree.nearest_warm_n(
+                &[
+                    q.x,
+                    q.y,
+                    q.z,
+                    weight * colour[0],
+                    weight * colour[1],
+                    weight * colour[2],
+                ],
+                warm,
+            ),
+        }
+    }
 }
 
 /// Order the `k` smallest of `items` by `key` (a distance, then a distinct index) first,
@@ -148,8 +167,9 @@ pub fn trimmed_icp(
     let mut pairs: Vec<(f64, usize, usize)> = Vec::with_capacity(n);
     let mut xs = Vec::with_capacity(n);
     let mut ys = Vec::with_capacity(n);
-    // Each guidance point's partner in the previous iteration: the next search starts there.
-    let mut prev = vec![usize::MAX; n];
+    // Each guidance point's partner in the previous iteration and the ball about it where that
+    // partner is certainly still the nearest: the next search starts there, or is not needed.
+    let mut prev = vec![Warm::default(); n];
     for _ in 0..o.iterations {
         let inv = t
             .matrix()
@@ -158,8 +178,7 @@ pub fn trimmed_icp(
         pairs.clear();
         for gi in 0..n {
             let q = inv.transform_point(&guidance.points[gi]);
-            if let Some((oi, _)) = matcher.nearest_from(&q, &guidance.colours[gi], prev[gi]) {
-                prev[gi] = oi;
+            if let Some((oi, _)) = matcher.nearest_warm(&q, &guidance.colours[gi], &mut prev[gi]) {
                 // Trim by the geometric distance only: with colour-aware matching the pairs
                 // whose colours disagree are the ones that turn a symmetric shape the right way;
                 // they are not outliers.

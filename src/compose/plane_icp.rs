@@ -105,8 +105,9 @@ pub fn plane_icp_offset(
     let n = guidance.len();
     // (point distance², plane residual, guidance index, object index)
     let mut pairs: Vec<(f64, usize, usize)> = Vec::with_capacity(n);
-    // Each guidance point's partner in the previous iteration: the next search starts there.
-    let mut prev = vec![usize::MAX; n];
+    // Each guidance point's partner in the previous iteration and its certificate: the next
+    // search starts there, or is not needed.
+    let mut prev = vec![super::kdtree::Warm::default(); n];
     for _ in 0..o.iterations {
         let Some(inv) = t.matrix().try_inverse() else {
             break;
@@ -115,8 +116,7 @@ pub fn plane_icp_offset(
         pairs.clear();
         for gi in 0..n {
             let q = inv.transform_point(&guidance.points[gi]);
-            if let Some((oi, _)) = matcher.nearest_from(&q, &guidance.colours[gi], prev[gi]) {
-                prev[gi] = oi;
+            if let Some((oi, _)) = matcher.nearest_warm(&q, &guidance.colours[gi], &mut prev[gi]) {
                 let p = m.transform_point(&object.points[oi]);
                 pairs.push(((p - guidance.points[gi]).norm_squared(), gi, oi));
             }
