@@ -215,10 +215,10 @@ pub fn run(args: &[String]) {
             std::process::exit(2);
         }
     };
-    // The support sweep (`--support off` switches it off; default on, as `compose`).
+    // The support sweep (`--support on`; off by default, as in `compose`).
     let support_sweep = match value("--support").map(String::as_str) {
-        Some("off") => None,
-        None | Some("on") => Some(interact3d::compose::support::SupportOptions::default()),
+        None | Some("off") => None,
+        Some("on") => Some(interact3d::compose::support::SupportOptions::default()),
         Some(other) => {
             eprintln!("--support {other}: expected on or off");
             std::process::exit(2);
