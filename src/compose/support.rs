@@ -18,9 +18,9 @@
 //! candidate is offered to the guard with the guidance's noise as the allowance, as the contact
 //! stage offers its candidate.
 //!
-//! Off by default (`ComposeOptions::support`): on the realistic benchmark it took the
-//! screwdriver s1 from −26 % to −13 % (still a miss) and moved items that were right (the teapot
-//! s4 from −2.7 % to +3.6 %), see docs/compose.md, "Twelfth stop".
+//! Off by default (`ComposeOptions::support`): on the realistic benchmark (seeds 0–4) it took
+//! the screwdriver s1 from −26 % to −13 % (still a miss), gained the die s1 and lost the teapot
+//! s4 at 2 % (−2.7 % → +3.6 %): the same counts, see docs/compose.md, "Twelfth stop".
 //!
 //! Entry points: [`apply`] (as `compose` calls it), [`resting_fit`] (one scale's resting pose),
 //! [`SupportOptions`], [`SupportReport`].
