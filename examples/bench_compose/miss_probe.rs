@@ -90,3 +90,84 @@ pub fn contact(
         report.map_or("-".to_string(), |r| serde_json::to_string(r).unwrap_or_default())
     );
 }
+
+/// `SUPPORT_PROBE=1`: is the resting contact a constraint the truth satisfies and a wrong size
+/// violates? For every item, at scales around the truth (and at the estimate's), the pose is
+/// refitted from the estimate rescaled about its visible part's centroid (a fixed-scale
+/// point-to-plane ICP with a normal offset, as the scale sweep does), and printed: the gap to
+/// the composed anchor (% of the item's diagonal at that scale), the guard's offset-out fit
+/// (cap fixed at the estimate's), and the fit once the item is moved along the support's
+/// normal to touch it (the pose a support-bounded sweep would judge).
+pub fn support(
+    id: &str,
+    inp: &ObjectInput,
+    anchor: &interact3d::mesh::Mesh,
+    truth: &Similarity,
+    est: &Similarity,
+) {
+    use interact3d::compose::contact_scale::{GapProbe, DENSE};
+    use interact3d::compose::plane_icp::plane_icp_offset;
+    use interact3d::compose::sdf::AnchorField;
+    let oc = Cloud::sample(&inp.visual, 5000, 1);
+    let tree = KdTree::new(&oc.points);
+    let sp = interact3d::compose::guard::spacing(&inp.visual, 5000);
+    let gc = Cloud::sample(&inp.guidance, 2500, 2);
+    let probe: Vec<_> = gc.subsample(1000).points;
+    let g700 = gc.subsample(700);
+    let diag = oc.diagonal();
+    let field = AnchorField::new(std::slice::from_ref(anchor), 32);
+    let gaps = GapProbe::new(
+        oc.subsample(1000).points,
+        &Cloud::sample(&inp.visual, DENSE, 4).points,
+    );
+    let cap = 0.03 * est.scale * diag;
+    let fit = |t: &Similarity| offset_fit(&oc, &tree, sp, &probe, t, cap, 0.03 * t.scale * diag).0;
+    // The visible part's centroid at the estimate (object samples within 2 % of the diagonal).
+    let inv = est.matrix().try_inverse().unwrap();
+    let near2 = (0.02 * diag).powi(2);
+    let mut seen = vec![false; oc.len()];
+    for g in &gc.points {
+        if let Some((i, d2)) = tree.nearest(&inv.transform_point(g)) {
+            seen[i] |= d2 <= near2;
+        }
+    }
+    let vis: Vec<_> = (0..oc.len()).filter(|&i| seen[i]).collect();
+    let pivot = interact3d::mesh::P3::from(
+        vis.iter().fold(interact3d::mesh::V3::zeros(), |a, &i| {
+            a + oc.points[i].coords
+        }) / vis.len().max(1) as f64,
+    );
+    let m = Matcher::Geometry(&tree);
+    let row = |label: String, t: &Similarity| -> String {
+        let g = gaps.gap(t, &field);
+        let mut touched = *t;
+        touched.translation -= g.normal.normalize() * g.value;
+        format!(
+            "{label}: gap {:+6.2} % fit {:.3e} touched {:.3e}",
+            100.0 * g.value / (t.scale * diag),
+            fit(t),
+            fit(&touched)
+        )
+    };
+    let mut rows = vec![row("est".into(), est), row("truth-pose".into(), truth)];
+    let ks = [0.75, 0.85, 0.9, 0.95, 1.0, 1.05, 1.1, 1.2, 1.3];
+    for k in ks {
+        let s = truth.scale * k;
+        let o = PlaneIcpOptions {
+            iterations: 12,
+            scale: false,
+            scale_lo: s,
+            scale_hi: s,
+            offset: true,
+            offset_max: 0.03 * s * diag,
+            ..Default::default()
+        };
+        let (t, _, _) = plane_icp_offset(&oc, &m, &g700, rescaled(est, s, &pivot), &o);
+        rows.push(row(format!("k {k:.2}"), &t));
+    }
+    eprintln!(
+        "  SUPPORT {id:<44} est scale {:+6.2} %\n    {}",
+        100.0 * (est.scale / truth.scale - 1.0),
+        rows.join("\n    ")
+    );
+}

@@ -215,6 +215,15 @@ pub fn run(args: &[String]) {
             std::process::exit(2);
         }
     };
+    // The support sweep (`--support on`; off by default, as in `compose`).
+    let support_sweep = match value("--support").map(String::as_str) {
+        None | Some("off") => None,
+        Some("on") => Some(interact3d::compose::support::SupportOptions::default()),
+        Some(other) => {
+            eprintln!("--support {other}: expected on or off");
+            std::process::exit(2);
+        }
+    };
     // The earlier realistic guidance: the objects' own surfaces, subdivided, with holes.
     let subdivided = args.iter().any(|a| a == "--subdivided");
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
@@ -298,6 +307,7 @@ pub fn run(args: &[String]) {
                     let o = ComposeOptions {
                         seed,
                         contact,
+                        support: support_sweep,
                         ..Default::default()
                     };
                     let t0 = Instant::now();
@@ -378,6 +388,9 @@ pub fn run(args: &[String]) {
                         });
                         placed.push(inp.visual.geometry().transformed(&est.matrix()));
                         truth_placed.push(inp.visual.geometry().transformed(&s.truth[n].matrix()));
+                        if n > 0 && std::env::var_os("SUPPORT_PROBE").is_some() {
+                            miss_probe::support(id, inp, &placed[0], &s.truth[n], &est);
+                        }
                         if verbose && n > 0 {
                             miss_probe::contact(
                                 id,
@@ -386,6 +399,12 @@ pub fn run(args: &[String]) {
                                 (&truth_placed[0], &s.truth[n]),
                                 r.contact.as_ref(),
                             );
+                            if let Some(sr) = &r.support {
+                                eprintln!(
+                                    "  SUPPORTSTAGE {id:<44} (pair {k:2}, seed {seed}) {}",
+                                    serde_json::to_string(sr).unwrap_or_default()
+                                );
+                            }
                         }
                     }
                     let mopts = MetricsOptions {
