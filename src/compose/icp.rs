@@ -70,6 +70,18 @@ pub enum Matcher<'a> {
     Colour { tree: &'a KdTreeN<6>, weight: f64 },
 }
 
+/// A point and its colour as one key of the colour tree, the colour weighted by `weight`.
+fn coloured(q: &P3, colour: &[f64; 3], weight: f64) -> [f64; 6] {
+    [
+        q.x,
+        q.y,
+        q.z,
+        weight * colour[0],
+        weight * colour[1],
+        weight * colour[2],
+    ]
+}
+
 impl<'a> Matcher<'a> {
     /// The 6-d tree of `object` for [`Matcher::Colour`].
     pub fn colour_tree(object: &Cloud, weight: f64) -> KdTreeN<6> {
@@ -78,7 +90,7 @@ impl<'a> Matcher<'a> {
                 .points
                 .iter()
                 .zip(&object.colours)
-                .map(|(p, c)| [p.x, p.y, p.z, weight * c[0], weight * c[1], weight * c[2]])
+                .map(|(p, c)| coloured(p, c, weight))
                 .collect(),
         )
     }
@@ -93,17 +105,9 @@ impl<'a> Matcher<'a> {
     pub fn nearest_from(&self, q: &P3, colour: &[f64; 3], hint: usize) -> Option<(usize, f64)> {
         match self {
             Matcher::Geometry(t) => t.nearest_from(q, hint),
-            Matcher::Colour { tree, weight } => tree.nearest_from_n(
-                &[
-                    q.x,
-                    q.y,
-                    q.z,
-                    weight * colour[0],
-                    weight * colour[1],
-                    weight * colour[2],
-                ],
-                hint,
-            ),
+            Matcher::Colour { tree, weight } => {
+                tree.nearest_from_n(&coloured(q, colour, *weight), hint)
+            }
         }
     }
 
@@ -112,17 +116,9 @@ impl<'a> Matcher<'a> {
     pub fn nearest_warm(&self, q: &P3, colour: &[f64; 3], warm: &mut Warm) -> Option<(usize, f64)> {
         match self {
             Matcher::Geometry(t) => t.nearest_warm(q, warm),
-            Matcher::Colour { tree, weight } => tree.nearest_warm_n(
-                &[
-                    q.x,
-                    q.y,
-                    q.z,
-                    weight * colour[0],
-                    weight * colour[1],
-                    weight * colour[2],
-                ],
-                warm,
-            ),
+            Matcher::Colour { tree, weight } => {
+                tree.nearest_warm_n(&coloured(q, colour, *weight), warm)
+            }
         }
     }
 }
