@@ -20,32 +20,11 @@ const SIDE: f64 = 0.05;
 fn leaning_cube_scene(dir: &Path, theta: f64) {
     std::fs::create_dir_all(dir.join("meshes")).unwrap();
     let h = SIDE / 2.0;
-    let mut obj = String::new();
-    for x in [-h, h] {
-        for y in [-h, h] {
-            for z in [-h, h] {
-                obj += &format!("v {x} {y} {z}\n");
-            }
-        }
-    }
-    // Vertex k + 1 has x = k & 4, y = k & 2, z = k & 1 (set = +h); faces wound outwards.
-    for f in [
-        [1, 3, 4],
-        [1, 4, 2],
-        [5, 6, 8],
-        [5, 8, 7],
-        [1, 2, 6],
-        [1, 6, 5],
-        [3, 7, 8],
-        [3, 8, 4],
-        [1, 5, 7],
-        [1, 7, 3],
-        [2, 4, 8],
-        [2, 8, 6],
-    ] {
-        obj += &format!("f {} {} {}\n", f[0], f[1], f[2]);
-    }
-    std::fs::write(dir.join("meshes/cube.obj"), obj).unwrap();
+    std::fs::write(
+        dir.join("meshes/cube.obj"),
+        common::box_extents_obj([SIDE; 3]),
+    )
+    .unwrap();
     let t = theta.to_radians();
     // R_y(θ) (h, 0, -h): the low edge's centre.
     let (ex, ez) = (h * t.cos() - h * t.sin(), -h * t.sin() - h * t.cos());

@@ -447,37 +447,6 @@ fn newton_imports_the_files() {
     }
 }
 
-/// An axis-aligned box of extents `e` (m) centred at the origin, as OBJ text.
-fn box_obj(e: [f64; 3]) -> String {
-    let h = e.map(|x| x / 2.0);
-    let mut obj = String::new();
-    for x in [-h[0], h[0]] {
-        for y in [-h[1], h[1]] {
-            for z in [-h[2], h[2]] {
-                obj += &format!("v {x} {y} {z}\n");
-            }
-        }
-    }
-    // Vertex k + 1 has x = k & 4, y = k & 2, z = k & 1 (set = +h); faces wound outwards.
-    for t in [
-        [1, 3, 4],
-        [1, 4, 2],
-        [5, 6, 8],
-        [5, 8, 7],
-        [1, 2, 6],
-        [1, 6, 5],
-        [3, 7, 8],
-        [3, 8, 4],
-        [1, 5, 7],
-        [1, 7, 3],
-        [2, 4, 8],
-        [2, 8, 6],
-    ] {
-        obj += &format!("f {} {} {}\n", t[0], t[1], t[2]);
-    }
-    obj
-}
-
 /// A heavily loaded body (one carrying at least `SettleOptions::load_ratio` times its own mass)
 /// carries PhysX solver iterations in its USD; every other body keeps PhysX's own. Two box
 /// stacks written here as our manifest, 0.4 m apart, each upper box 0.1 mm above the lower:
@@ -500,7 +469,11 @@ fn loaded_bodies_carry_the_loaded_solver_iterations() {
     ];
     let mut objects = Vec::new();
     for (name, e, density, x, bottom) in boxes {
-        std::fs::write(scene.join(format!("meshes/{name}.obj")), box_obj(e)).unwrap();
+        std::fs::write(
+            scene.join(format!("meshes/{name}.obj")),
+            common::box_extents_obj(e),
+        )
+        .unwrap();
         objects.push(serde_json::json!({
             "name": name,
             "mesh": format!("meshes/{name}.obj"),

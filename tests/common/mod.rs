@@ -310,3 +310,35 @@ pub fn walk(dir: &Path) -> Vec<PathBuf> {
     }
     out
 }
+
+/// An axis-aligned box of extents `e` (m) centred at the origin, as OBJ text (`asset_cases::box_obj`
+/// takes half-extents and winds its faces in another order).
+pub fn box_extents_obj(e: [f64; 3]) -> String {
+    let h = e.map(|x| x / 2.0);
+    let mut obj = String::new();
+    for x in [-h[0], h[0]] {
+        for y in [-h[1], h[1]] {
+            for z in [-h[2], h[2]] {
+                obj += &format!("v {x} {y} {z}\n");
+            }
+        }
+    }
+    // Vertex k + 1 has x = k & 4, y = k & 2, z = k & 1 (set = +h); faces wound outwards.
+    for t in [
+        [1, 3, 4],
+        [1, 4, 2],
+        [5, 6, 8],
+        [5, 8, 7],
+        [1, 2, 6],
+        [1, 6, 5],
+        [3, 7, 8],
+        [3, 8, 4],
+        [1, 5, 7],
+        [1, 7, 3],
+        [2, 4, 8],
+        [2, 8, 6],
+    ] {
+        obj += &format!("f {} {} {}\n", t[0], t[1], t[2]);
+    }
+    obj
+}
