@@ -131,6 +131,7 @@ pub fn loaded_iterations(o: &SettleOptions) -> (u32, u32) {
 impl PhysxCtx {
     /// The settings of the settle test `o`.
     pub fn from_settle(o: &SettleOptions) -> Self {
+        let (loaded_position_iterations, loaded_velocity_iterations) = loaded_iterations(o);
         PhysxCtx {
             angular_damping: f(o.angular_damping),
             linear_damping: f(o.linear_damping),
@@ -138,8 +139,8 @@ impl PhysxCtx {
             // Rapier's default combine rule; the settle never sets another.
             friction_combine: "average",
             floor_friction: f(o.floor_friction),
-            loaded_position_iterations: loaded_iterations(o).0,
-            loaded_velocity_iterations: loaded_iterations(o).1,
+            loaded_position_iterations,
+            loaded_velocity_iterations,
         }
     }
 }
