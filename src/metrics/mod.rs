@@ -81,7 +81,7 @@ use crate::mesh::{Mesh, P3};
 use crate::rng::Rng;
 use bvh::{Bb, Bvh};
 /// Squared distance between two closed triangles (0 when they intersect): vertex–triangle and
-/// edge–edge distances after an intersection test. `examples/make_fixtures.rs` checks the
+/// edge–edge distances after an intersection test. `examples/make_fixtures/` checks the
 /// fixtures' gaps with it.
 pub use geom::tri_tri_dist2;
 use geom::V;
