@@ -32,6 +32,7 @@ use interact3d::metrics::{pair_metrics, MetricsOptions, Prepared, Solid};
 use std::path::Path;
 use std::time::Instant;
 
+mod colour_probe;
 mod guidance_stats;
 mod miss_probe;
 mod profile;

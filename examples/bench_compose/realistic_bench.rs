@@ -12,6 +12,7 @@ use std::collections::BTreeMap;
 use std::path::Path;
 use std::time::Instant;
 
+use super::colour_probe;
 use super::guidance_stats::{self, GuidanceStats};
 use super::miss_probe;
 use super::profile_probe;
@@ -196,6 +197,8 @@ pub fn run(args: &[String]) {
     let verbose = args.iter().any(|a| a == "-v");
     // `--profile-probe`: the axial profile's scale of each object, no compose ([`profile_probe`]).
     let profile_only = args.iter().any(|a| a == "--profile-probe");
+    // `--colour-probe`: the colour profile's scale of each object, no compose ([`colour_probe`]).
+    let colour_only = args.iter().any(|a| a == "--colour-probe");
     // `--dump`: each object's pose and stage fits at full precision (stderr), so two builds
     // can be diffed for the same results (a cost-only change must print the same lines).
     let dump = args.iter().any(|a| a == "--dump");
@@ -298,6 +301,13 @@ pub fn run(args: &[String]) {
                         }
                         continue;
                     }
+                    if colour_only {
+                        for (n, inp) in s.inputs.iter().enumerate() {
+                            let id = if n == 0 { sid } else { iid };
+                            colour_probe::print(id, seed, inp, &s.truth[n]);
+                        }
+                        continue;
+                    }
                     let gstats: Vec<GuidanceStats> = s
                         .inputs
                         .iter()
@@ -388,6 +398,10 @@ pub fn run(args: &[String]) {
                         });
                         placed.push(inp.visual.geometry().transformed(&est.matrix()));
                         truth_placed.push(inp.visual.geometry().transformed(&s.truth[n].matrix()));
+                        if std::env::var_os("COLOUR_JUDGE").is_some() {
+                            let anchor = (n > 0).then(|| &placed[0]);
+                            colour_probe::judge(id, seed, inp, &s.truth[n], &est, anchor);
+                        }
                         if n > 0 && std::env::var_os("SUPPORT_PROBE").is_some() {
                             miss_probe::support(id, inp, &placed[0], &s.truth[n], &est);
                         }

@@ -11,6 +11,8 @@
 //!    weighted when both meshes carry colour, [`colour`]);
 //! 4. scale-aware trimmed ICP with Umeyama and a bounded scale ([`icp`]), on the guidance part
 //!    without the placed objects' surface (segmentation bleed, [`bleed`]);
+//!    for an elongated object with colour, the size its colour along the long axis gives,
+//!    kept only when the guard finds it fits not worse ([`colour_axis`]);
 //! 5. an item's size from its resting contact ([`contact_scale`]; optionally first among
 //!    resting poses, [`support`], off by default);
 //! 6. collision-aware refinement of every further object against the fixed, already composed
@@ -24,6 +26,7 @@ pub mod agent;
 pub mod bleed;
 pub mod cloud;
 pub mod colour;
+pub mod colour_axis;
 pub mod contact_scale;
 pub mod features;
 pub mod folder;
@@ -380,6 +383,16 @@ fn register(
             let m = &matcher;
             let (ot, g) = (object_tree, &mut guard);
             if let Some(r) = sweep::sweep(object, ot, m, &g_icp, &pl, bounds, OFFSET_MAX, g, &o) {
+                rms = r;
+            }
+        }
+        // The size the colour along the long axis gives, judged by the guard ([`colour_axis`]).
+        if use_colour {
+            let bounds = (icp.scale_lo, icp.scale_hi);
+            let (m, g) = (&matcher, &mut guard);
+            if let Some(r) =
+                colour_axis::stage(object, guidance, m, &g_icp, &pl, bounds, OFFSET_MAX, g)
+            {
                 rms = r;
             }
         }
