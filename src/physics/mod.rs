@@ -39,6 +39,7 @@ pub mod equilibrium;
 mod fresh;
 pub mod load_ratio;
 pub mod probe;
+mod rolling;
 mod settle;
 mod world;
 
@@ -189,6 +190,11 @@ pub struct SettleOptions {
     /// released tilted 4° on the floor rocks up to 7.3° in 4 s with 1°, and comes to rest with
     /// 0.05° (`tests/contact_statics.rs`). Every moving contact is recomputed more often.
     pub contact_reuse_max_turn_deg: f64,
+    /// Rolling friction (m, MuJoCo's third `friction` value): two bodies in contact (or a body
+    /// and the floor) resist rolling on each other with a torque of at most this times their
+    /// contacts' normal force (the `rolling` module); a ball of radius r on an incline stays
+    /// while tan θ ≤ rolling_friction / r. 0: none, Rapier's own contacts.
+    pub rolling_friction: f64,
     /// Rapier's contact recycling: a pair whose relative pose moved less than
     /// `contact_recycle_distance` since its last narrow-phase update keeps its contact points.
     /// Its reported contact distances then go stale, which does not matter here: every
@@ -284,6 +290,7 @@ impl Default for SettleOptions {
             perturbation_speed: 0.001,
             prediction_distance: 0.002,
             contact_reuse_max_turn_deg: 1.0,
+            rolling_friction: 0.0,
             contact_recycling: true,
             contact_recycle_distance: 0.0005,
             max_relative_drift: 0.10,
