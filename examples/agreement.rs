@@ -261,6 +261,7 @@ fn set(o: &mut SettleOptions, kv: &str) {
         "angular_damping" => o.angular_damping = x,
         "prediction_distance" => o.prediction_distance = x,
         "contact_reuse_max_turn_deg" => o.contact_reuse_max_turn_deg = x,
+        "rolling_friction" => o.rolling_friction = x,
         "contact_recycling" => o.contact_recycling = x != 0.0,
         "coulomb_friction" => o.coulomb_friction = x != 0.0,
         "contact_clustering" => o.contact_clustering = x != 0.0,

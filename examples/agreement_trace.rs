@@ -34,6 +34,8 @@ fn main() {
                 "loaded_fresh_contacts" => opts.loaded_fresh_contacts = x != 0.0,
                 "loaded_stiff_contacts" => opts.loaded_stiff_contacts = x != 0.0,
                 "coulomb_friction" => opts.coulomb_friction = x != 0.0,
+                "contact_reuse_max_turn_deg" => opts.contact_reuse_max_turn_deg = x,
+                "rolling_friction" => opts.rolling_friction = x,
                 "contact_clustering" => opts.contact_clustering = x != 0.0,
                 "friction_in_bias_pass" => opts.friction_in_bias_pass = x != 0.0,
                 "sleep" if x == 0.0 => opts.sleep_linear_threshold = 0.0,

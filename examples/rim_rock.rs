@@ -32,6 +32,7 @@ fn main() {
                 "friction_in_bias_pass" => opts.friction_in_bias_pass = x != 0.0,
                 "prediction_distance" => opts.prediction_distance = x,
                 "contact_reuse_max_turn_deg" => opts.contact_reuse_max_turn_deg = x,
+                "rolling_friction" => opts.rolling_friction = x,
                 "contact_frequency" => opts.contact_frequency = x,
                 "static_contact_frequency" => opts.static_contact_frequency = x,
                 "contact_damping_ratio" => opts.contact_damping_ratio = x,

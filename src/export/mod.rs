@@ -38,6 +38,22 @@ pub const GENERATOR: &str = concat!("interact3d ", env!("CARGO_PKG_VERSION"));
 /// settle test's friction, combined by averaging as Rapier does: [`usd::PhysxCtx`]).
 const FLOOR_FRICTION: f64 = 1.0;
 
+/// The MJCF's contact dimension and torsional and rolling friction, from the settle test's
+/// options (the file says what the settle assumed): `condim="6"` with the settle's
+/// [`rolling_friction`](crate::physics::SettleOptions::rolling_friction) as the geoms' third
+/// `friction` value when it has one, else `condim="4"` (sliding and torsional friction) and
+/// MuJoCo's default rolling coefficient, which condim 4 ignores. PhysX has no rolling friction:
+/// the USD cannot state it.
+fn mjcf_contact() -> minijinja::Value {
+    let rolling = crate::physics::SettleOptions::default().rolling_friction;
+    let (condim, rolling) = if rolling > 0.0 {
+        (6, rolling)
+    } else {
+        (4, 0.0001)
+    };
+    minijinja::context! { condim => condim, torsion => f(0.005), rolling => f(rolling) }
+}
+
 /// Options of the export stage.
 #[derive(Clone, Debug, Default)]
 pub struct ExportOptions {
@@ -133,13 +149,18 @@ fn write_mjcf_urdf_json(
         bodies => ctx_bodies.to_vec(),
         keyframes => keyframes,
         floor_friction => f(FLOOR_FRICTION),
+        contact => mjcf_contact(),
     };
     crate::fsutil::write(
         &dir.join("scene.xml"),
         templates.render("scene.xml.j2", scene_ctx)?.as_bytes(),
     )?;
     for b in ctx_bodies {
-        let ctx = minijinja::context! { generator => GENERATOR, b => b.clone() };
+        let ctx = minijinja::context! {
+            generator => GENERATOR,
+            b => b.clone(),
+            contact => mjcf_contact(),
+        };
         crate::fsutil::write(
             &dir.join(format!("{}.xml", b.name)),
             templates.render("object.xml.j2", ctx.clone())?.as_bytes(),

@@ -21,7 +21,8 @@
 //! bottle, docs/agreement.md "Twelfth stop"). [`Fresh::max_turn_cos`] recomputes a manifold
 //! whose normal turned more than
 //! [`SettleOptions::contact_reuse_max_turn_deg`](super::SettleOptions::contact_reuse_max_turn_deg)
-//! since it was computed; at parry's own 1° nothing changes.
+//! since it was computed; at parry's own 1° (the default) nothing changes. The kept normal is
+//! also an accidental rolling resistance; the `rolling` module has a deliberate one.
 
 use rapier3d_f64::geometry::{ContactData, ContactManifoldData};
 use rapier3d_f64::math::{Pose, Real, Vector};

@@ -39,6 +39,7 @@ pub mod equilibrium;
 mod fresh;
 pub mod load_ratio;
 pub mod probe;
+mod rolling;
 mod settle;
 mod world;
 
@@ -187,8 +188,18 @@ pub struct SettleOptions {
     /// since it was computed. parry's own limit is 1°; 1 or more keeps it. Below it, a body
     /// rocking on a rim no longer pushes along a normal that turns with it: a 32-sided cylinder
     /// released tilted 4° on the floor rocks up to 7.3° in 4 s with 1°, and comes to rest with
-    /// 0.05° (`tests/contact_statics.rs`). Every moving contact is recomputed more often.
+    /// 0.01° (`tests/contact_statics.rs`). Every moving contact is recomputed more often.
+    /// The kept normal is also an accidental rolling resistance; 0.01° with
+    /// [`SettleOptions::rolling_friction`] 0.1 mm was measured as a default over 0..700 and
+    /// not kept (docs/agreement.md "Thirteenth stop").
     pub contact_reuse_max_turn_deg: f64,
+    /// Rolling friction (m, MuJoCo's third `friction` value): two bodies in contact (or a body
+    /// and the floor) resist rolling on each other with a torque of at most this times their
+    /// contacts' normal force (the `rolling` module); a ball of radius r on an incline stays
+    /// while tan θ ≤ rolling_friction / r. 0 (the default): none, Rapier's own contacts. When
+    /// the default is above 0 the MJCF export writes it (`condim="6"`); MuJoCo's own default
+    /// coefficient is 0.1 mm.
+    pub rolling_friction: f64,
     /// Rapier's contact recycling: a pair whose relative pose moved less than
     /// `contact_recycle_distance` since its last narrow-phase update keeps its contact points.
     /// Its reported contact distances then go stale, which does not matter here: every
@@ -284,6 +295,7 @@ impl Default for SettleOptions {
             perturbation_speed: 0.001,
             prediction_distance: 0.002,
             contact_reuse_max_turn_deg: 1.0,
+            rolling_friction: 0.0,
             contact_recycling: true,
             contact_recycle_distance: 0.0005,
             max_relative_drift: 0.10,

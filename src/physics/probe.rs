@@ -103,7 +103,7 @@ fn probe_one(
         act.angular_threshold = -1.0;
     }
     for _ in 0..steps_for(opts.probe_time, opts.dt) {
-        sim.world.step();
+        sim.step();
     }
     Ok((0..n)
         .map(|i| {

@@ -23,7 +23,7 @@ pub fn settle(bodies: &[SimBody], opts: &SettleOptions) -> Result<SettleReport, 
     let mut settle_steps = 0;
     let mut time_to_sleep = if dynamic.is_empty() { Some(0.0) } else { None };
     while time_to_sleep.is_none() && settle_steps < max_settle_steps {
-        sim.world.step();
+        sim.step();
         settle_steps += 1;
         if dynamic
             .iter()
@@ -61,7 +61,7 @@ pub fn settle(bodies: &[SimBody], opts: &SettleOptions) -> Result<SettleReport, 
     let mut rest_rot = vec![0.0f64; n];
     let mut rest_pen = vec![(0.0f64, None::<usize>); n];
     for _ in 0..rest_steps {
-        sim.world.step();
+        sim.step();
         for &i in &dynamic {
             let p = sim.pose(i);
             let (d, r) = drift(&settled[i], &p, &bodies[i].com);
@@ -297,7 +297,7 @@ pub fn simulate(
     let mut times = vec![0.0];
     let mut frames = vec![frame(&sim)];
     for s in 1..=steps {
-        sim.world.step();
+        sim.step();
         if (record_every > 0 && s % record_every == 0) || s == steps {
             times.push(s as f64 * opts.dt);
             frames.push(frame(&sim));

@@ -580,7 +580,7 @@ fn ball_floor_depth(opts: &SettleOptions, start_depth: f64, steps: usize) -> f64
     };
     let mut sim = Sim::new(std::slice::from_ref(&ball), &sim_opts).unwrap();
     for _ in 0..steps {
-        sim.world.step();
+        sim.step();
     }
     sim.penetrations()[0].0
 }

@@ -1,6 +1,7 @@
 //! The Rapier world built from [`SimBody`]s ([`Sim`]): bodies, colliders, the floor, the exact
 //! contact queries the checks use, and [`rapier_mass_properties`].
 
+use super::rolling;
 use super::*;
 use rapier3d_f64::dynamics::FrictionModel;
 
@@ -106,6 +107,8 @@ pub(super) struct Sim<'a> {
     pub(super) bbox_diagonal: Vec<f64>,
     /// Distance from the centre of mass to the farthest hull vertex.
     pub(super) reach: Vec<f64>,
+    /// The rolling resistance's torques ([`SettleOptions::rolling_friction`]).
+    rolling: rolling::Rolling,
 }
 
 impl<'a> Sim<'a> {
@@ -212,7 +215,9 @@ impl<'a> Sim<'a> {
                 .restitution(opts.restitution),
             Some(floor),
         );
+        let rolling = rolling::Rolling::new(opts.rolling_friction, &handles);
         Ok(Sim {
+            rolling,
             bodies,
             opts,
             world,
@@ -221,6 +226,13 @@ impl<'a> Sim<'a> {
             bbox_diagonal,
             reach,
         })
+    }
+
+    /// One Rapier step, then the rolling resistance's torques for the next
+    /// ([`SettleOptions::rolling_friction`]).
+    pub(super) fn step(&mut self) {
+        self.world.step();
+        self.rolling.update(&mut self.world, &self.handles);
     }
 
     /// The perturbation of [`SettleOptions::perturbation_speed`]: every dynamic body turns about
@@ -452,6 +464,7 @@ pub(super) fn validate_options(o: &SettleOptions) -> Result<(), PhysicsError> {
         ("linear_damping", o.linear_damping),
         ("prediction_distance", o.prediction_distance),
         ("contact_reuse_max_turn_deg", o.contact_reuse_max_turn_deg),
+        ("rolling_friction", o.rolling_friction),
         ("contact_recycle_distance", o.contact_recycle_distance),
         ("angular_damping", o.angular_damping),
         ("perturbation_speed", o.perturbation_speed),
