@@ -285,7 +285,7 @@ fn judge(scene: &Path, extra: &[&str]) -> (serde_json::Value, serde_json::Value)
 
 /// Every body has `PhysxRigidBodyAPI` with the settle's damping and depenetration speed, every
 /// hull and the ground `PhysxCollisionAPI` with PhysX's own contact offset and a rest offset
-/// of 0 (on a scene with a heavily loaded body, a hull's offset is within 2 mm of 0: the depth
+/// of 0 (on a scene with a heavily loaded body, a hull's offset is between -2 mm and 0: the depth
 /// its stack rests at, `loaded_stacks_rest_at_the_settles_depth`), every material
 /// `PhysxMaterialAPI` averaging friction as Rapier does, and the ground has the settle's floor
 /// friction.
@@ -340,8 +340,8 @@ fn physx_settings_are_the_settles(u: &serde_json::Value, report: &serde_json::Va
         if !loaded || p.as_str() == "/World/Ground/Collider" {
             assert!(rest == 0.0, "{what}: {p}: {a}");
         } else {
-            // The depth of a loaded stack.
-            assert!(rest.abs() <= 2.0 * MM, "{what}: {p}: {a}");
+            // The depth of a loaded stack, never an air gap.
+            assert!((-2.0 * MM..=0.0).contains(&rest), "{what}: {p}: {a}");
         }
     }
     let materials = with("PhysxMaterialAPI");
