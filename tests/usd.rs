@@ -227,7 +227,7 @@ fn judge(scene: &Path, extra: &[&str]) -> (serde_json::Value, serde_json::Value)
 
     // The PhysX settings the settle test assumed, as usd-core reads them with the PhysX schemas
     // registered: every body, collider and material carries them (src/export/usd.rs, PhysxCtx).
-    physx_settings_are_the_settles(&u, objects, &what.to_string());
+    physx_settings_are_the_settles(&u, &report, &what.to_string());
 
     // PhysX cooks every hull as written: its cooked vertices are authored ones, and every
     // authored vertex lies within 0.1 mm of the cooked hull (PhysX may drop a vertex that sits
@@ -284,14 +284,16 @@ fn judge(scene: &Path, extra: &[&str]) -> (serde_json::Value, serde_json::Value)
 }
 
 /// Every body has `PhysxRigidBodyAPI` with the settle's damping and depenetration speed, every
-/// hull and the ground `PhysxCollisionAPI` with rest offset 0 (and PhysX's own contact
-/// offset), every material `PhysxMaterialAPI` averaging friction as Rapier does, and the
-/// ground has the settle's floor friction.
-fn physx_settings_are_the_settles(
-    u: &serde_json::Value,
-    objects: &[serde_json::Value],
-    what: &str,
-) {
+/// hull and the ground `PhysxCollisionAPI` with PhysX's own contact offset and a rest offset
+/// of 0 (on a scene with a heavily loaded body, a hull's offset is between -2 mm and 0: the depth
+/// its stack rests at, `loaded_stacks_rest_at_the_settles_depth`), every material
+/// `PhysxMaterialAPI` averaging friction as Rapier does, and the ground has the settle's floor
+/// friction.
+fn physx_settings_are_the_settles(u: &serde_json::Value, report: &serde_json::Value, what: &str) {
+    let objects = report["objects"].as_array().unwrap();
+    let loaded = report["validation"]["settle"]["heavily_loaded"]
+        .as_array()
+        .is_some_and(|l| !l.is_empty());
     let o = interact3d::physics::SettleOptions::default();
     let authored = u["physx_authored"].as_object().unwrap();
     let with = |schema: &str| -> Vec<(&String, &serde_json::Value)> {
@@ -334,10 +336,13 @@ fn physx_settings_are_the_settles(
             a.get("physxCollision:contactOffset").is_none(),
             "{what}: {p}: {a}"
         );
-        assert!(
-            near(&a["physxCollision:restOffset"], 0.0),
-            "{what}: {p}: {a}"
-        );
+        let rest = f(&a["physxCollision:restOffset"]);
+        if !loaded || p.as_str() == "/World/Ground/Collider" {
+            assert!(rest == 0.0, "{what}: {p}: {a}");
+        } else {
+            // The depth of a loaded stack, never an air gap.
+            assert!((-2.0 * MM..=0.0).contains(&rest), "{what}: {p}: {a}");
+        }
     }
     let materials = with("PhysxMaterialAPI");
     assert_eq!(
@@ -542,4 +547,103 @@ fn loaded_bodies_carry_the_loaded_solver_iterations() {
             assert_eq!(counts, (None, None), "{name}: {a}");
         }
     }
+    loaded_stacks_rest_at_the_settles_depth(&boxes, &loaded_by_hand, &u);
+}
+
+/// The rest offsets of the boxes of `loaded_bodies_carry_the_loaded_solver_iterations`, from
+/// their exported poses: the loaded stack (dice under brick) rests its contacts as deep as our
+/// settle left them, each pair's offsets summing to minus its depth (the dice's on the floor,
+/// the dice's and the brick's), computed here from the boxes' extents and poses; the other
+/// stack (not loaded) keeps 0. PhysX, from the exported pose, moves the brick less than a fifth
+/// of the depth it would push out with rigid contacts.
+fn loaded_stacks_rest_at_the_settles_depth(
+    boxes: &[(&str, [f64; 3], f64, f64, f64); 4],
+    loaded_by_hand: &[bool; 4],
+    u: &serde_json::Value,
+) {
+    let authored = u["physx_authored"].as_object().unwrap();
+    let offset = |name: &str| {
+        f(
+            &authored[&format!("/World/{name}/Collisions/Hull_00")]["attrs"]
+                ["physxCollision:restOffset"],
+        )
+    };
+    // A box's corners at its exported pose (body frame at its centre) and its rotation.
+    let placed = |k: usize| -> (Vec<nalgebra::Point3<f64>>, nalgebra::Rotation3<f64>) {
+        let (name, e, ..) = boxes[k];
+        let b = &u["usdphysics"]["bodies"][name];
+        let q: Vec<f64> = (0..4).map(|i| f(&b["orientation"][i])).collect();
+        let r = nalgebra::UnitQuaternion::from_quaternion(nalgebra::Quaternion::new(
+            q[0], q[1], q[2], q[3],
+        ))
+        .to_rotation_matrix();
+        let c = nalgebra::Vector3::new(
+            f(&b["position"][0]),
+            f(&b["position"][1]),
+            f(&b["position"][2]),
+        );
+        let corners = (0..8)
+            .map(|m| {
+                let s = |bit: usize| if m >> bit & 1 == 1 { 0.5 } else { -0.5 };
+                let local = nalgebra::Vector3::new(s(0) * e[0], s(1) * e[1], s(2) * e[2]);
+                nalgebra::Point3::from(c + r * local)
+            })
+            .collect();
+        (corners, r)
+    };
+    let (dice, rd) = placed(0);
+    let (brick, rb) = placed(1);
+    let floor_depth = -dice.iter().map(|p| p.z).fold(f64::INFINITY, f64::min);
+    // Two boxes resting face on face: the penetration is the smaller overlap along the two
+    // face normals (the dice's top, the brick's bottom); a separating-axis depth.
+    let along = |n: nalgebra::Vector3<f64>| -> f64 {
+        let hi = dice
+            .iter()
+            .map(|p| n.dot(&p.coords))
+            .fold(f64::MIN, f64::max);
+        let lo = brick
+            .iter()
+            .map(|p| n.dot(&p.coords))
+            .fold(f64::MAX, f64::min);
+        hi - lo
+    };
+    let up = |r: &nalgebra::Rotation3<f64>| {
+        let n = r * nalgebra::Vector3::z();
+        if n.z < 0.0 {
+            -n
+        } else {
+            n
+        }
+    };
+    let pair_depth = along(up(&rd)).min(along(up(&rb)));
+    // r_dice + 0 = -floor depth; r_dice + r_brick = -pair depth; written to the micrometre.
+    let want = [-floor_depth, floor_depth - pair_depth];
+    for (k, w) in want.iter().enumerate() {
+        let got = offset(boxes[k].0);
+        assert!(
+            (got - w).abs() <= 3e-6,
+            "{}: rest offset {got} m, the settle's depth says {w} m",
+            boxes[k].0
+        );
+    }
+    assert!(loaded_by_hand[0] && !loaded_by_hand[2]);
+    for k in [2, 3] {
+        assert_eq!(
+            offset(boxes[k].0),
+            0.0,
+            "{}: not a loaded stack",
+            boxes[k].0
+        );
+    }
+    let moved = f(&u["physx"]["bodies"][boxes[1].0]["moved_m"]);
+    eprintln!(
+        "loaded stack: floor depth {:.4} mm, pair depth {:.4} mm; PhysX moved the brick {:.4} mm",
+        floor_depth / MM,
+        pair_depth / MM,
+        moved / MM
+    );
+    assert!(
+        moved <= 0.2 * pair_depth,
+        "PhysX moved the brick {moved} m out of a {pair_depth} m deep rest"
+    );
 }

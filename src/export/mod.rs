@@ -16,6 +16,7 @@
 mod files;
 pub mod format;
 pub mod read;
+pub mod rest_offset;
 mod templates;
 pub mod usd;
 

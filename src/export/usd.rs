@@ -47,6 +47,9 @@ struct MeshCtx {
     normals: String,
     st: Option<String>,
     extent: String,
+    /// A hull's `physxCollision:restOffset` (m): the depth its loaded stack rests at
+    /// ([`super::rest_offset`]), 0 outside one; empty for a visual mesh.
+    rest_offset: String,
 }
 
 #[derive(Clone, Serialize)]
@@ -158,18 +161,20 @@ pub fn write_usd(
     loaded: &[String],
 ) -> Result<()> {
     let prims = prim_names(a.bodies.iter().map(|b| b.name.as_str()));
+    let offsets = super::rest_offset::rest_offsets(a, loaded);
     // One file per body, written side by side; the first error in body order is reported.
-    let jobs: Vec<(&Body, &BodyFiles, String)> = a
+    let jobs: Vec<(&Body, &BodyFiles, String, Vec<f64>)> = a
         .bodies
         .iter()
         .zip(files)
         .zip(prims)
-        .map(|((b, fl), prim)| (b, fl, prim))
+        .zip(offsets)
+        .map(|(((b, fl), prim), r)| (b, fl, prim, r))
         .collect();
     let written: Vec<Result<ObjectCtx>> = jobs
         .into_par_iter()
-        .map(|(b, fl, prim)| {
-            let ctx = object_context(b, fl, prim, loaded.contains(&b.name));
+        .map(|(b, fl, prim, rest_offset)| {
+            let ctx = object_context(b, fl, prim, loaded.contains(&b.name), &rest_offset);
             let text = templates.render(
                 "object.usda.j2",
                 minijinja::context! {
@@ -226,7 +231,13 @@ fn prim_names<'a>(names: impl Iterator<Item = &'a str>) -> Vec<String> {
     out
 }
 
-fn object_context(b: &Body, files: &BodyFiles, prim: String, loaded: bool) -> ObjectCtx {
+fn object_context(
+    b: &Body,
+    files: &BodyFiles,
+    prim: String,
+    loaded: bool,
+    rest_offsets: &[f64],
+) -> ObjectCtx {
     let (diag, axes) = principal_axes(&b.inertial.inertia);
     let c = b.inertial.com;
     let groups = material_groups(b);
@@ -264,6 +275,7 @@ fn object_context(b: &Body, files: &BodyFiles, prim: String, loaded: bool) -> Ob
                     s
                 }),
                 extent: extent(&p.positions),
+                rest_offset: String::new(),
             });
         }
     }
@@ -280,6 +292,7 @@ fn object_context(b: &Body, files: &BodyFiles, prim: String, loaded: bool) -> Ob
             normals: String::new(),
             st: None,
             extent: extent(&in_hull_units(&h.vertices)),
+            rest_offset: f(rest_offsets[k]),
         })
         .collect();
     let quat = |q: &UnitQuaternion<f64>| tuple(&[q.w, q.i, q.j, q.k]);
