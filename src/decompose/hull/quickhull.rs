@@ -123,6 +123,11 @@ impl Work {
     }
 }
 
+/// Facet slots beyond which a thread's buffers are dropped after the call (the hull of a
+/// whole mesh), so that they keep only what the search's small hulls (at most 64 points, a
+/// few hundred facets) reuse: kept whole, they raised the scenes' peak RSS by 1-5 MiB.
+const KEEP_FACETS: usize = 2048;
+
 thread_local! {
     static WORK: RefCell<Work> = RefCell::new(Work::default());
 }
@@ -134,7 +139,13 @@ pub fn convex_hull(points: &[Vector3]) -> Result<(Vec<Vector3>, Vec<[u32; 3]>), 
         return Err(Failed);
     }
     WORK.with(|w| match w.try_borrow_mut() {
-        Ok(mut w) => w.hull(points),
+        Ok(mut w) => {
+            let hull = w.hull(points);
+            if w.facets.len() > KEEP_FACETS {
+                *w = Work::default();
+            }
+            hull
+        }
         // Re-entered on this thread (cannot happen: nothing here calls back): parry's own.
         Err(_) => parry3d_f64::transformation::try_convex_hull(points).map_err(|_| Failed),
     })
@@ -146,6 +157,9 @@ impl Work {
         self.undecidable.clear();
         self.normalized.clear();
         self.normalized.extend_from_slice(points);
+        // Zero here, and zeroed again where `fix_silhouette_topology` counted.
+        self.workspace.clear();
+        self.workspace.resize(points.len(), 0);
         // `convex_hull_utils::normalize`.
         let aabb = parry3d_f64::bounding_volume::details::local_point_cloud_aabb_ref(
             self.normalized.iter(),
@@ -308,9 +322,10 @@ impl Work {
         }
     }
 
+    /// parry's `fix_silhouette_topology`, its per-point counts in `workspace` (zero on entry,
+    /// zeroed again on a normal return where they were counted, instead of a new vector each
+    /// time).
     fn fix_silhouette_topology(&mut self) -> Result<(), Failed> {
-        self.workspace.clear();
-        self.workspace.resize(self.normalized.len(), 0);
         let mut needs_fixing = false;
         for &(facet, adj_id) in &self.silhouette {
             let p = self.facets[facet].second_point_from_edge(adj_id);
@@ -320,6 +335,9 @@ impl Work {
             }
         }
         if !needs_fixing {
+            for &(facet, adj_id) in &self.silhouette {
+                self.workspace[self.facets[facet].second_point_from_edge(adj_id)] = 0;
+            }
             return Ok(());
         }
         let mut loop_start = 0;
@@ -367,6 +385,9 @@ impl Work {
             } else {
                 self.silhouette.push((facet, adj_id));
             }
+        }
+        for &(facet, adj_id) in &self.silhouette_old {
+            self.workspace[self.facets[facet].second_point_from_edge(adj_id)] = 0;
         }
         Ok(())
     }
