@@ -1,3 +1,9 @@
+//! Convex hulls ([`Hull`]): `Hull::from_points` (parry's quickhull, [`quickhull`]),
+//! `Hull::from_mesh`, point tests, and the PhysX-limit simplifications (`simplified`,
+//! `significant`, `within`).
+
+mod quickhull;
+
 use crate::mesh::{from_dvec, to_dvec, Aabb, Mesh, P3, V3};
 
 /// A convex hull: its vertices, triangles (outward), face planes and volume, in `f64`.
@@ -53,10 +59,13 @@ impl Hull {
             return None;
         }
         let pts: Vec<_> = points.iter().map(to_dvec).collect();
-        let (v, t) =
-            std::panic::catch_unwind(|| parry3d_f64::transformation::try_convex_hull(&pts))
-                .ok()?
-                .ok()?;
+        // parry's quickhull with its buffers kept (see `quickhull`), its output to the bit.
+        let got = std::panic::catch_unwind(|| quickhull::convex_hull(&pts))
+            .ok()
+            .and_then(|r| r.ok());
+        #[cfg(test)]
+        quickhull::assert_parry_agrees(&pts, got.as_ref());
+        let (v, t) = got?;
         let mesh = Mesh::new(v.into_iter().map(from_dvec).collect(), t);
         Hull::from_mesh(mesh)
     }

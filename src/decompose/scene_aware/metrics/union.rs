@@ -16,7 +16,8 @@
 
 use super::pieces::Pieces;
 use crate::decompose::Hull;
-use crate::mesh::{from_dvec, to_dvec, Aabb, Mesh, P3};
+use crate::mesh::{from_dvec, to_dvec, Aabb, Mesh, P3, V3};
+use parry3d_f64::math::Vector;
 use parry3d_f64::query::PointQuery;
 use parry3d_f64::shape::TriMesh;
 use rayon::prelude::*;
@@ -30,11 +31,16 @@ struct Faces {
     ends: Vec<usize>,
     /// The box of `tris` and their BVH; `None` when the hull lies inside the others.
     query: Option<(Aabb, TriMesh)>,
+    /// The unit normal of each of `tris` (by index, the BVH's leaf index), for the plane skip
+    /// of [`UnionFaces::distance`].
+    normals: Vec<V3>,
 }
 
 /// The boundary of the union of a set of hulls, by hull (see the module's doc).
 pub struct UnionFaces {
     eps: f64,
+    /// The object's diagonal (`eps` is 1e-6 of it): the scale of the plane skip's slack.
+    diag: f64,
     /// The hulls' boxes, by index.
     boxes: Vec<Aabb>,
     faces: Vec<Arc<Faces>>,
@@ -57,6 +63,7 @@ impl UnionFaces {
             .collect();
         UnionFaces {
             eps,
+            diag,
             boxes: hulls.iter().map(|h| h.aabb).collect(),
             faces,
         }
@@ -102,6 +109,7 @@ impl UnionFaces {
             .collect();
         UnionFaces {
             eps,
+            diag: self.diag,
             boxes: hulls.iter().map(|h| h.aabb).collect(),
             faces,
         }
@@ -130,25 +138,62 @@ impl UnionFaces {
     /// distance to parry's projection on the triangle of least cost, and a triangle's cost and
     /// that distance are the same sum of squares' root.
     pub fn distance(&self, p: &P3) -> f64 {
-        let mut near: Vec<(f64, &(Aabb, TriMesh))> = self
+        let mut near: Vec<(f64, &Faces)> = self
             .faces
             .iter()
-            .filter_map(|f| f.query.as_ref())
-            .map(|q| (box_distance(&q.0, p), q))
+            .filter_map(|f| Some((box_distance(&f.query.as_ref()?.0, p), &**f)))
             .collect();
         near.sort_by(|a, b| a.0.total_cmp(&b.0));
         let q = to_dvec(p);
         let mut best = f64::INFINITY;
-        for (lower, (_, mesh)) in near {
+        for (lower, f) in near {
             if lower > best * (1.0 + BOX_MARGIN) {
                 break;
             }
-            if let Some(proj) = mesh.project_local_point_with_max_dist(q, false, best.min(f64::MAX))
-            {
-                best = best.min((from_dvec(proj.point) - p).norm());
+            if let Some(proj) = f.project(q, best.min(f64::MAX), self.diag) {
+                best = best.min((from_dvec(proj) - p).norm());
             }
         }
         best
+    }
+}
+
+/// How much farther than the best so far, relatively, a triangle's plane must lie for parry's
+/// projection of the triangle to be skipped, and the slack of the plane test as a fraction of
+/// the diagonal: `Surface::project_local`'s `SKIP_MARGIN` and `PLANE_SLACK`, by the same
+/// argument (the distance to the plane by a unit normal is a lower bound on the distance to the
+/// triangle, within rounding far below both).
+const SKIP_MARGIN: f64 = 1e-6;
+const PLANE_SLACK: f64 = 1e-12;
+
+impl Faces {
+    /// The point parry's `project_local_point_with_max_dist(q, false, max_dist)` finds on this
+    /// hull's triangles, to the bit: the same best-first search of the same BVH, the same
+    /// triangle projections and costs, but for triangles whose plane lies beyond the best so
+    /// far by more than [`SKIP_MARGIN`], which parry would not have taken (their cost is at
+    /// least the plane's distance), so the search keeps the same best at every step.
+    fn project(&self, q: Vector, max_dist: f64, diag: f64) -> Option<Vector> {
+        let (_, mesh) = self.query.as_ref()?;
+        let (_, (_, point)) = mesh.bvh().find_best(
+            max_dist,
+            |node, _| node.aabb().distance_to_local_point(q, true),
+            |i, best| {
+                let t = mesh.triangle(i);
+                if best < f64::MAX {
+                    let lim = best * (1.0 + SKIP_MARGIN);
+                    let n = self.normals[i as usize];
+                    let ap = q - t.a;
+                    let plane = (n.x * ap.x + n.y * ap.y + n.z * ap.z).abs();
+                    // False for NaN: parry's projection decides then.
+                    if plane > lim + PLANE_SLACK * diag {
+                        return None;
+                    }
+                }
+                let proj = t.project_local_point(q, false);
+                Some(((proj.point - q).length(), proj.point))
+            },
+        )?;
+        Some(point)
     }
 }
 
@@ -200,7 +245,24 @@ fn faces_of(hulls: &[Hull], i: usize, eps: f64, reuse: Option<(&Faces, &[Aabb])>
             .collect();
         (b, TriMesh::new(v, t).expect("triangles"))
     });
-    Faces { tris, ends, query }
+    let normals = tris
+        .iter()
+        .map(|[a, b, c]| {
+            let cr = (b - a).cross(&(c - a));
+            let len = cr.norm();
+            if len > 0.0 {
+                cr / len
+            } else {
+                V3::zeros()
+            }
+        })
+        .collect();
+    Faces {
+        tris,
+        ends,
+        query,
+        normals,
+    }
 }
 
 #[cfg(test)]
