@@ -13,7 +13,11 @@
 //! `Triangle`); inputs that are not 3-dimensional (a point, a segment, a plane by parry's
 //! eigenvalue test) go to parry itself.
 //!
-//! parry is Apache-2.0 licensed; the loop below follows its `convex_hull3` module.
+//! Derived from parry3d-f64 0.31.1's `transformation/convex_hull3` (Copyright Sébastien Crozet,
+//! <https://github.com/dimforge/parry>, licensed under the Apache License, Version 2.0). What this
+//! file changes: the buffers are kept between calls; the algorithm and its arithmetic are parry's.
+//! When parry's hull changes, `tests.rs` beside this file (every result compared with
+//! `try_convex_hull` to the bit) says so, and this copy follows it or goes.
 
 use parry3d_f64::math::{MatExt, Vector3, DEFAULT_EPSILON};
 use parry3d_f64::shape::Triangle;
