@@ -151,6 +151,17 @@ pub fn rotation_angle(q: &UnitQuaternion<f64>) -> f64 {
     q.angle()
 }
 
+/// parry's pose of an isometry (the same rotation and translation; parry's own math types).
+pub fn parry_pose(iso: &Isometry3<f64>) -> parry3d_f64::math::Pose {
+    use parry3d_f64::math::{Pose, Rotation, Vector};
+    let q = iso.rotation.quaternion();
+    let t = iso.translation.vector;
+    Pose::from_parts(
+        Vector::new(t.x, t.y, t.z),
+        Rotation::from_xyzw(q.i, q.j, q.k, q.w),
+    )
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

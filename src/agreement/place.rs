@@ -4,8 +4,9 @@
 //! an item on a mug's rim from being found inside the mug's wall.
 
 use super::CatalogObject;
+use crate::pose::parry_pose;
 use nalgebra::{Isometry3, Point3, Translation3, UnitQuaternion};
-use rapier3d_f64::math::{Pose, Rotation, Vector};
+use rapier3d_f64::math::{Pose, Vector};
 use rapier3d_f64::parry::query;
 use rapier3d_f64::parry::shape::ConvexPolyhedron;
 
@@ -16,15 +17,6 @@ pub struct Placer {
 
 const STEP: f64 = 0.002;
 const BISECTIONS: usize = 30;
-
-fn to_pose(iso: &Isometry3<f64>) -> Pose {
-    let q = iso.rotation.quaternion();
-    let t = iso.translation.vector;
-    Pose::from_parts(
-        Vector::new(t.x, t.y, t.z),
-        Rotation::from_xyzw(q.i, q.j, q.k, q.w),
-    )
-}
 
 type Bounds = ([f64; 3], [f64; 3]);
 
@@ -90,7 +82,7 @@ impl Placer {
             .flat_map(|(j, pose)| {
                 self.shapes[*j]
                     .iter()
-                    .map(move |(s, pts)| (s, to_pose(pose), bounds(pts, pose)))
+                    .map(move |(s, pts)| (s, parry_pose(pose), bounds(pts, pose)))
             })
             .collect();
         let Some(top) = others.iter().map(|o| o.2 .1[2]).reduce(f64::max) else {
@@ -98,7 +90,7 @@ impl Placer {
         };
         let hits = |z: f64| -> bool {
             let iso = Isometry3::from_parts(Translation3::new(x, y, z), *rot);
-            let pose = to_pose(&iso);
+            let pose = parry_pose(&iso);
             self.shapes[k].iter().any(|(s, pts)| {
                 let b = bounds(pts, &iso);
                 others.iter().any(|(o, op, ob)| {

@@ -24,22 +24,14 @@
 
 use crate::body::Assembly;
 use crate::decompose::scene_aware::geom::polyhedron;
-use nalgebra::{DMatrix, DVector, Isometry3};
-use parry3d_f64::math::{Pose, Rotation, Vector};
+use crate::pose::parry_pose;
+use nalgebra::{DMatrix, DVector};
+use parry3d_f64::math::Pose;
 use parry3d_f64::query;
 use parry3d_f64::shape::ConvexPolyhedron;
 
 /// Offsets are written to the micrometre (PhysX's own tolerance is coarser).
 const RESOLUTION: f64 = 1e-6;
-
-fn to_pose(iso: &Isometry3<f64>) -> Pose {
-    let q = iso.rotation.quaternion();
-    let t = iso.translation.vector;
-    Pose::from_parts(
-        Vector::new(t.x, t.y, t.z),
-        Rotation::from_xyzw(q.i, q.j, q.k, q.w),
-    )
-}
 
 /// Penetration depths (m, > 0) of the hulls at the bodies' current poses: `(h, g, depth)`
 /// with hulls numbered body by body (body 0's first, then body 1's…) and `g = None` for the
@@ -50,7 +42,12 @@ pub fn hull_depths(a: &Assembly) -> Vec<(usize, Option<usize>, f64)> {
     let shapes: Vec<(Pose, Vec<Option<ConvexPolyhedron>>)> = a
         .bodies
         .iter()
-        .map(|b| (to_pose(&b.pose), b.hulls.iter().map(polyhedron).collect()))
+        .map(|b| {
+            (
+                parry_pose(&b.pose),
+                b.hulls.iter().map(polyhedron).collect(),
+            )
+        })
         .collect();
     let mut out = Vec::new();
     for (i, b) in a.bodies.iter().enumerate() {

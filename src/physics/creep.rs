@@ -13,8 +13,9 @@
 //! friction cones; a falling, tipping or rolling body has no such forces.
 
 use super::equilibrium::{balance, Contact, Load};
-use super::world::{to_pose, Sim};
+use super::world::Sim;
 use super::*;
+use crate::pose::parry_pose;
 use nalgebra::Vector3;
 use rapier3d_f64::parry::query::{
     ContactManifold, DefaultQueryDispatcher, PersistentQueryDispatcher,
@@ -33,7 +34,7 @@ impl Sim<'_> {
         let n = self.bodies.len();
         let hulls: Vec<Vec<(Pose, &dyn Shape, Aabb)>> = (0..n)
             .map(|i| {
-                let pose = to_pose(&poses[i]);
+                let pose = parry_pose(&poses[i]);
                 self.colliders[i]
                     .iter()
                     .map(|&c| {

@@ -3,6 +3,7 @@
 
 use super::rolling;
 use super::*;
+use crate::pose::parry_pose;
 use rapier3d_f64::dynamics::FrictionModel;
 
 /// The mass properties Rapier gives a body built from `body` (for checks and debugging): the
@@ -21,15 +22,6 @@ pub fn rapier_mass_properties(body: &SimBody) -> Result<(f64, P3, Matrix3<f64>),
         P3::new(c.x, c.y, c.z),
         Matrix3::from_fn(|r, k| m.col(k)[r]),
     ))
-}
-
-pub(super) fn to_pose(iso: &Isometry3<f64>) -> Pose {
-    let q = iso.rotation.quaternion();
-    let t = iso.translation.vector;
-    Pose::from_parts(
-        Vector::new(t.x, t.y, t.z),
-        Rotation::from_xyzw(q.i, q.j, q.k, q.w),
-    )
 }
 
 pub(super) fn from_pose(p: &Pose) -> Isometry3<f64> {
@@ -530,7 +522,7 @@ pub(super) fn body_builder(
             format!("friction must be ≥ 0, got {}", b.friction),
         ));
     }
-    let pose = to_pose(&b.pose);
+    let pose = parry_pose(&b.pose);
     if b.fixed {
         return Ok((RigidBodyBuilder::fixed().pose(pose).build(), diag));
     }

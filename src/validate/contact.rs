@@ -11,9 +11,10 @@
 
 use crate::decompose::Hull;
 use crate::io::asset::{Geom, Shape};
+use crate::pose::parry_pose;
 use nalgebra::{Isometry3, UnitQuaternion, Vector3};
 use parry3d_f64::bounding_volume::BoundingVolume;
-use parry3d_f64::math::{Pose, Rotation, Vector};
+use parry3d_f64::math::{Pose, Vector};
 use parry3d_f64::query;
 use parry3d_f64::shape::{ConvexPolyhedron, Segment, SharedShape};
 
@@ -51,16 +52,6 @@ pub fn exact_primitive(g: &Geom) -> Option<(SharedShape, f64, Isometry3<f64>)> {
     })
 }
 
-/// parry's pose of an isometry.
-pub fn to_pose(iso: &Isometry3<f64>) -> Pose {
-    let q = iso.rotation.quaternion();
-    let t = iso.translation.vector;
-    Pose::from_parts(
-        Vector::new(t.x, t.y, t.z),
-        Rotation::from_xyzw(q.i, q.j, q.k, q.w),
-    )
-}
-
 impl Collider {
     /// A primitive in its body placed at `body` (world).
     pub fn primitive(
@@ -71,7 +62,7 @@ impl Collider {
     ) -> Collider {
         Collider {
             core,
-            pose: to_pose(&(body * local)),
+            pose: parry_pose(&(body * local)),
             radius,
         }
     }
