@@ -186,7 +186,7 @@ impl Work {
             }
             let pt_id = {
                 let f = &self.facets[i];
-                indexed_support_point_id(f.normal, &self.normalized, f.visible.iter().copied())
+                support(f.normal, &self.normalized, f.visible.iter().copied()).map(|(_, i)| i)
             };
             if let Some(point) = pt_id {
                 self.facets[i].valid = false;
@@ -255,8 +255,12 @@ impl Work {
         for point in self.normalized.iter_mut() {
             *point = (*point - center) / max_eigval;
         }
-        let p1 = support_point_id(eigpairs[0].0, &self.normalized).ok_or(Failed)?;
-        let p2 = support_point_id(-eigpairs[0].0, &self.normalized).ok_or(Failed)?;
+        let p1 = support(eigpairs[0].0, &self.normalized, 0..self.normalized.len())
+            .ok_or(Failed)?
+            .1;
+        let p2 = support(-eigpairs[0].0, &self.normalized, 0..self.normalized.len())
+            .ok_or(Failed)?
+            .1;
         let mut max_area = 0.0;
         let mut p3 = usize::MAX;
         for (i, point) in self.normalized.iter().enumerate() {
@@ -348,7 +352,7 @@ impl Work {
         for &(facet, adj_id) in &self.silhouette {
             let p1 = self.normalized[self.facets[facet].second_point_from_edge(adj_id)];
             let p2 = self.normalized[self.facets[facet].first_point_from_edge(adj_id)];
-            let supp = indexed_support_point_nth(
+            let (supp, _) = support(
                 p2 - p1,
                 &self.normalized,
                 self.silhouette
@@ -502,47 +506,20 @@ impl Work {
     }
 }
 
-fn support_point_id(direction: Vector3, points: &[Vector3]) -> Option<usize> {
-    let mut argmax = None;
-    let mut max = -f64::MAX;
-    for (id, pt) in points.iter().enumerate() {
-        let dot = direction.dot(*pt);
-        if dot > max {
-            argmax = Some(id);
-            max = dot;
-        }
-    }
-    argmax
-}
-
-fn indexed_support_point_id(
+/// The first of `idx`'s points farthest along `direction` (parry's `support_point_id`,
+/// `indexed_support_point_id` and `indexed_support_point_nth` are this one loop): its position
+/// in `idx` and its index, `None` when `idx` is empty.
+fn support(
     direction: Vector3,
     points: &[Vector3],
     idx: impl Iterator<Item = usize>,
-) -> Option<usize> {
-    let mut argmax = None;
-    let mut max = -f64::MAX;
-    for i in idx {
-        let dot = direction.dot(points[i]);
-        if dot > max {
-            argmax = Some(i);
-            max = dot;
-        }
-    }
-    argmax
-}
-
-fn indexed_support_point_nth(
-    direction: Vector3,
-    points: &[Vector3],
-    idx: impl Iterator<Item = usize>,
-) -> Option<usize> {
+) -> Option<(usize, usize)> {
     let mut argmax = None;
     let mut max = -f64::MAX;
     for (k, i) in idx.enumerate() {
         let dot = direction.dot(points[i]);
         if dot > max {
-            argmax = Some(k);
+            argmax = Some((k, i));
             max = dot;
         }
     }
