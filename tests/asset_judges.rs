@@ -1,4 +1,4 @@
-//! The engines' own verdict on the asset cases of tests/assets.rs: PyBullet on every URDF case
+//! The engines' own verdict on the asset cases of tests/assets/: PyBullet on every URDF case
 //! (loads or refuses, contact at the start, motion), MuJoCo on every MJCF case with a physics
 //! verdict (motion), and the rest test: the half-cylinder rocker (fires) and its upright twin,
 //! and the YCB URDFs whose placeholder inertia kept them rocking.

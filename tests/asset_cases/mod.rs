@@ -1,4 +1,4 @@
-//! Planted asset cases and engine judges shared by tests/assets.rs and tests/asset_judges.rs:
+//! Planted asset cases and engine judges shared by tests/assets/ and tests/asset_judges.rs:
 //! one-link URDFs around exact boxes, the mug with a ball inside or beside its hull, two boxes on
 //! a floor, the half-cylinder rocker; and how an engine's motion reads as a verdict.
 #![allow(dead_code)]
