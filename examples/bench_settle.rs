@@ -11,7 +11,10 @@ use interact3d::physics::{settle, simulate, SettleOptions, SimBody};
 use interact3d::shapes::cuboid;
 use nalgebra::{Isometry3, Matrix3, Matrix4, Vector3};
 use std::f64::consts::PI;
-use std::time::Instant;
+
+#[path = "common/timing.rs"]
+mod timing;
+use timing::best_of;
 
 fn bowl() -> SimBody {
     let walls = 31;
@@ -73,18 +76,6 @@ fn box_inertia(m: f64, e: V3) -> Matrix3<f64> {
         m / 12.0 * (e.x * e.x + e.z * e.z),
         m / 12.0 * (e.x * e.x + e.y * e.y),
     ))
-}
-
-fn best_of<T>(runs: usize, mut f: impl FnMut() -> T) -> (f64, T) {
-    let mut best = f64::INFINITY;
-    let mut out = None;
-    for _ in 0..runs {
-        let t = Instant::now();
-        let r = f();
-        best = best.min(t.elapsed().as_secs_f64());
-        out = Some(r);
-    }
-    (best, out.unwrap())
 }
 
 fn main() {

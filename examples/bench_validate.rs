@@ -9,19 +9,10 @@ use interact3d::metrics::{r_surface, r_volume, MetricsOptions, Prepared, Solid};
 use interact3d::pipeline::load_assembly;
 use interact3d::validate::{sim_bodies, validate, ValidateOptions};
 use std::path::PathBuf;
-use std::time::Instant;
 
-fn best<T>(runs: usize, mut f: impl FnMut() -> T) -> (f64, T) {
-    let mut best = f64::INFINITY;
-    let mut out = None;
-    for _ in 0..runs {
-        let t = Instant::now();
-        let r = f();
-        best = best.min(t.elapsed().as_secs_f64());
-        out = Some(r);
-    }
-    (best, out.unwrap())
-}
+#[path = "common/timing.rs"]
+mod timing;
+use timing::best_of;
 
 fn main() {
     let root = PathBuf::from(env!("CARGO_MANIFEST_DIR"));
@@ -41,32 +32,32 @@ fn main() {
         .num_threads(1)
         .build_global()
         .unwrap();
-    let (t_build, a) = best(1, || {
+    let (t_build, a) = best_of(1, || {
         load_assembly(&scene, &Default::default(), &BuildOptions::default()).unwrap()
     });
     let world: Vec<_> = a.bodies.iter().map(|b| b.world_geometry()).collect();
     let tris: Vec<usize> = world.iter().map(|m| m.triangles.len()).collect();
     let hulls: Vec<usize> = a.bodies.iter().map(|b| b.hulls.len()).collect();
-    let (t_prep, prepared) = best(3, || {
+    let (t_prep, prepared) = best_of(3, || {
         world
             .iter()
             .map(|m| Prepared::new(Solid::Mesh(m)))
             .collect::<Vec<_>>()
     });
     let opts = MetricsOptions::default();
-    let (t_rvol, rv) = best(3, || r_volume(&prepared[0], &prepared[1], &opts));
-    let (t_rsurf, rs) = best(3, || r_surface(&prepared[0], &prepared[1]));
+    let (t_rvol, rv) = best_of(3, || r_volume(&prepared[0], &prepared[1], &opts));
+    let (t_rsurf, rs) = best_of(3, || r_surface(&prepared[0], &prepared[1]));
     let vopts = ValidateOptions::default();
     let bodies = sim_bodies(&a);
     let mut two_s = vopts.settle.clone();
     two_s.settle_max_time = 2.0;
-    let (t_sim, _) = best(3, || {
+    let (t_sim, _) = best_of(3, || {
         interact3d::physics::simulate(&bodies, &two_s, 2.0, 0).unwrap()
     });
-    let (t_settle, rep) = best(3, || {
+    let (t_settle, rep) = best_of(3, || {
         interact3d::physics::settle(&bodies, &vopts.settle).unwrap()
     });
-    let (t_val, v) = best(3, || validate(&a, &vopts).unwrap());
+    let (t_val, v) = best_of(3, || validate(&a, &vopts).unwrap());
     println!(
         "scene: {} ({} objects, triangles {:?}, hulls {:?})\n",
         scene.display(),
