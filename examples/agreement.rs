@@ -11,7 +11,9 @@
 //!       [--set KEY=VALUE] [--max-hull-polygons N] [--nudge]` (`--nudge`: for every verdict
 //! disagreement, our verdict again from the composed pose nudged by 0.5 mm / 0.5°, 8 starts a
 //! free body (`agreement::nudge`), written to OUT/nudges.jsonl and counted: a disagreement whose
-//! engine verdict some nudged start of ours shares is within our own spread; `--max-hull-polygons 64`: the hulls a user
+//! engine verdict some nudged start of ours shares is within our own spread; with `--physx`, the
+//! same for PhysX's disagreements, and PhysX's own verdict from the same nudged starts (the
+//! file a user gets, nudged as ours is), to OUT/nudges_physx.jsonl; `--max-hull-polygons 64`: the hulls a user
 //! exporting for Isaac gets, the ones PhysX should judge; `--only`: these seeds instead; `--set`: a settle option, for
 //! experiments; `--physx-every K`:
 //! PhysX judges one batch in K, it is about 4x slower than MuJoCo; the judges' interpreter:
@@ -22,7 +24,8 @@
 mod seeds;
 use interact3d::agreement::nudge::{self, Spread};
 use interact3d::agreement::{
-    judge::judge_with, run_scene_with, summary, Catalog, Generated, Judged, Summary,
+    judge::{judge_nudged, judge_with},
+    run_scene_with, summary, Catalog, Generated, Judged, Summary,
 };
 use interact3d::physics::SettleOptions;
 use rayon::prelude::*;
@@ -105,6 +108,11 @@ fn main() {
     let mut nudge_lines =
         nudge.then(|| std::fs::File::create(out.join("nudges.jsonl")).expect("nudges.jsonl"));
     let mut nudged: Vec<(bool, Spread)> = Vec::new();
+    let mut nudge_px_lines = (nudge && physx).then(|| {
+        std::fs::File::create(out.join("nudges_physx.jsonl")).expect("nudges_physx.jsonl")
+    });
+    let mut nudged_px: Vec<(bool, Spread)> = Vec::new();
+    let mut physx_spread: Vec<(bool, Spread)> = Vec::new();
     let mut all_px: Vec<Judged> = Vec::new();
     let seed_list: Vec<u64> = only.clone().unwrap_or_else(|| seeds.clone().collect());
     for (k, chunk) in seed_list.chunks(batch).enumerate() {
@@ -131,14 +139,32 @@ fn main() {
             settle.settle_max_time,
         );
         if let Some(px) = px_lines.as_mut().filter(|_| k % physx_every == 0) {
-            all_px.extend(judged_by(
+            let judged_px = judged_by(
                 "PhysX",
                 &python,
                 &physx_script,
                 &done,
                 px,
                 settle.settle_max_time,
-            ));
+            );
+            if nudge {
+                let gens: Vec<_> = done.iter().map(|d| &d.0).collect();
+                nudged_px.extend(nudge_disagreements(
+                    &gens,
+                    &judged_px,
+                    &settle,
+                    &mut nudge_px_lines,
+                ));
+                physx_spread.extend(physx_nudged(
+                    &python,
+                    &physx_script,
+                    &done,
+                    &judged_px,
+                    settle.settle_max_time,
+                    &mut nudge_px_lines,
+                ));
+            }
+            all_px.extend(judged_px);
         }
         if !keep {
             for (_, _, d) in &done {
@@ -168,13 +194,7 @@ fn main() {
     }
     print_table("MuJoCo", &(if only.is_some() { 0..0 } else { seeds }), &s);
     if nudge {
-        let within = nudged.iter().filter(|(v, sp)| sp.includes(*v)).count();
-        let split = nudged.iter().filter(|(_, sp)| sp.undetermined()).count();
-        println!(
-            "verdict disagreements within our own nudged spread (0.5 mm / 0.5 deg): {within} of {} \
-             ({split} with our nudged verdicts split)",
-            nudged.len()
-        );
+        print_spread(&nudged);
     }
     if physx {
         let s = summary(&all_px);
@@ -186,11 +206,99 @@ fn main() {
         let seeds: Vec<u64> = all_px.iter().map(|j| j.seed).collect();
         println!("\nPhysX judged seeds: {seeds:?}");
         print_table("PhysX", &(0..0), &s);
+        if nudge {
+            print_spread(&nudged_px);
+            let within = physx_spread
+                .iter()
+                .filter(|(v, sp)| sp.includes(*v))
+                .count();
+            let split = physx_spread
+                .iter()
+                .filter(|(_, sp)| sp.undetermined())
+                .count();
+            println!(
+                "verdict disagreements where some nudged start (0.5 mm / 0.5 deg) of PhysX's \
+                 gives our verdict: {within} of {} ({split} with PhysX's nudged verdicts split)",
+                physx_spread.len()
+            );
+        }
     }
 }
 
-/// `--nudge`: our verdict over the nudged composed poses of each MuJoCo verdict disagreement
-/// (one line each to `lines`); returns (MuJoCo's verdict, our spread) of each.
+/// `--nudge` with `--physx`: PhysX's own verdict over the nudged composed poses of each of its
+/// verdict disagreements (the same starts as ours; one line each to `lines`); returns (our
+/// verdict, PhysX's spread) of each.
+fn physx_nudged(
+    python: &str,
+    script: &std::path::Path,
+    done: &[(Generated, interact3d::agreement::Ours, PathBuf)],
+    judged: &[Judged],
+    settle_s: f64,
+    lines: &mut Option<std::fs::File>,
+) -> Vec<(bool, Spread)> {
+    let todo: Vec<_> = done
+        .iter()
+        .filter(|d| {
+            judged
+                .iter()
+                .any(|j| j.seed == d.0.seed && !j.verdict_agrees)
+        })
+        .cloned()
+        .collect();
+    if todo.is_empty() {
+        return Vec::new();
+    }
+    let res = judge_nudged("PhysX", python, script, &todo, settle_s).unwrap_or_else(|e| {
+        eprintln!("PhysX nudges: {e}");
+        Vec::new()
+    });
+    res.iter()
+        .map(|j| {
+            let v = j.mujoco.nudged.clone().unwrap_or_default();
+            let sp = Spread {
+                runs: v.len(),
+                passed: v.iter().filter(|&&p| p).count(),
+            };
+            eprintln!(
+                "seed {}: we {}, PhysX {}; PhysX from its nudged starts: {} of {} pass{}",
+                j.seed,
+                if j.ours.passed { "pass" } else { "fail" },
+                if j.mujoco.passed { "passes" } else { "fails" },
+                sp.passed,
+                sp.runs,
+                if sp.includes(j.ours.passed) {
+                    " (our verdict within PhysX's spread)"
+                } else {
+                    ""
+                }
+            );
+            if let Some(f) = lines.as_mut() {
+                let v = serde_json::json!({"seed": j.seed, "ours": j.ours.passed,
+                    "engine": j.mujoco.passed, "engine_nudged_runs": sp.runs,
+                    "engine_nudged_passed": sp.passed, "engine_nudged": v,
+                    "ours_within_engine_spread": sp.includes(j.ours.passed)});
+                writeln!(f, "{v}").expect("nudges_physx.jsonl");
+            }
+            (j.ours.passed, sp)
+        })
+        .collect()
+}
+
+/// `--nudge`'s count: of the verdict disagreements, those whose engine verdict some nudged
+/// start of ours shares, and those whose nudged verdicts split.
+fn print_spread(nudged: &[(bool, Spread)]) {
+    let within = nudged.iter().filter(|(v, sp)| sp.includes(*v)).count();
+    let split = nudged.iter().filter(|(_, sp)| sp.undetermined()).count();
+    println!(
+        "verdict disagreements within our own nudged spread (0.5 mm / 0.5 deg): {within} of {} \
+         ({split} with our nudged verdicts split)",
+        nudged.len()
+    );
+}
+
+/// `--nudge`: our verdict over the nudged composed poses of each verdict disagreement of one
+/// engine's judged scenes (one line each to `lines`); returns (the engine's verdict, our
+/// spread) of each.
 fn nudge_disagreements(
     gens: &[&Generated],
     judged: &[Judged],
@@ -205,7 +313,7 @@ fn nudge_disagreements(
     let res: Vec<_> = todo
         .par_iter()
         .filter_map(|(g, j)| match nudge::spread(g, settle) {
-            Ok(sp) => Some((j.seed, j.ours.passed, j.mujoco.passed, sp)),
+            Ok(sp) => Some((j.seed, j.ours.passed, j.mujoco.passed, sp, j.engine.clone())),
             Err(e) => {
                 eprintln!("seed {}: nudges: {e}", j.seed);
                 None
@@ -213,15 +321,15 @@ fn nudge_disagreements(
         })
         .collect();
     res.into_iter()
-        .map(|(seed, ours, engine, sp)| {
+        .map(|(seed, ours, engine, sp, name)| {
             eprintln!(
-                "seed {seed}: we {}, MuJoCo {}; nudged: {} of {} pass{}",
+                "seed {seed}: we {}, {name} {}; nudged: {} of {} pass{}",
                 if ours { "pass" } else { "fail" },
                 if engine { "passes" } else { "fails" },
                 sp.passed,
                 sp.runs,
                 if sp.includes(engine) {
-                    " (MuJoCo's verdict within our spread)"
+                    " (the engine's verdict within our spread)"
                 } else {
                     ""
                 }

@@ -13,6 +13,9 @@
 //! PhysX's, and with the rule off Rapier squeezes the scissors out: a failure the engines do
 //! not share. Not every such stack agrees: of this catalog's six loaded scenes we pass in
 //! 0..40, MuJoCo fails seed 30 and moves the box of seeds 5 and 32 past 1 mm (docs/agreement.md).
+//!
+//! A third case runs PhysX's own verdict from the nudged composed poses (`judge_nudged`, what
+//! `agreement --physx --nudge` counts) on that stack: every nudged start passes, as in ours.
 
 mod common;
 
@@ -162,5 +165,48 @@ fn heavy_item_on_light_one_agrees_only_with_the_load_rule() {
         }
         // (c) without the rule our verdict (a fail) is not the engine's.
         assert_ne!(off.passed, j.mujoco.passed, "{engine}");
+    }
+}
+
+/// PhysX's own verdict from nudged composed poses (`judge_nudged`, the `--nudge` count of the
+/// generator): the loaded stack above (a 4.1 kg box lying flat on 47 g scissors) nudged by
+/// 0.5° or 0.5 mm stays a pass in PhysX from every start, as in ours: one start a nudge of
+/// ours (`validate::nudge::nudged_poses`, 8 a free body), and the unnudged answer is the
+/// plain judge's to the bit.
+#[test]
+fn physx_keeps_a_flat_load_from_every_nudged_start() {
+    use interact3d::agreement::judge::{judge_nudged, judge_with};
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/datasets/objects");
+    let catalog = Catalog::load(&dir, Some(&LOADED), Some(tmp.path().join("cache"))).unwrap();
+    let g = catalog.compose(LOADED_SEED);
+    let out = tmp.path().join("scene");
+    let ours = run_scene(&g, &out).unwrap();
+    assert!(ours.passed, "{:?}", ours.reasons);
+    let settle = SettleOptions::default();
+    let our_nudged = interact3d::agreement::nudge::verdicts(&g, &settle).unwrap();
+    let python = common::python();
+    let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/python/agreement_physx.py");
+    let scenes = [(g, ours, out)];
+    let plain = &judge_with("PhysX", &python, &script, &scenes, settle.settle_max_time).unwrap()[0];
+    let nudged =
+        &judge_nudged("PhysX", &python, &script, &scenes, settle.settle_max_time).unwrap()[0];
+    let v = nudged.mujoco.nudged.clone().expect("nudged verdicts");
+    eprintln!("ours nudged {our_nudged:?}; PhysX nudged {v:?}");
+    assert!(plain.mujoco.nudged.is_none());
+    assert_eq!(v.len(), 16);
+    assert_eq!(v.len(), our_nudged.len());
+    assert!(
+        v.iter().all(|&p| p),
+        "PhysX dropped the load from a nudged start: {v:?}"
+    );
+    assert!(our_nudged.iter().all(|&p| p), "{our_nudged:?}");
+    assert_eq!(plain.mujoco.passed, nudged.mujoco.passed);
+    for (name, b) in &plain.mujoco.bodies {
+        let n = &nudged.mujoco.bodies[name];
+        assert_eq!(
+            (b.settle_m, b.rest_m, b.from_settled_m),
+            (n.settle_m, n.rest_m, n.from_settled_m)
+        );
     }
 }

@@ -10,6 +10,9 @@
 //! soup can MuJoCo was still rocking and a spoon still sliding into a mug counted as failures
 //! where both come to rest (seeds 83 and 93 of 0..300; docs/agreement.md). The engine's rest answer: from the exported
 //! (settled) pose, every body stays within 1 mm and 1° for 2 s.
+//!
+//! Entry points: [`judge`], [`judge_with`], [`judge_nudged`] (the engine's verdict from our
+//! nudged composed poses as well, PhysX only), [`summary`].
 
 use super::{Generated, Ours};
 use crate::error::{Error, Result};
@@ -55,6 +58,10 @@ pub struct MjScene {
     pub finite: bool,
     pub bodies: BTreeMap<String, MjBody>,
     pub seconds: f64,
+    /// The engine's own verdict from the composed pose nudged as our validator nudges it
+    /// (`validate::nudge::nudged_poses`' starts and order), when asked ([`judge_nudged`]).
+    #[serde(default)]
+    pub nudged: Option<Vec<bool>>,
 }
 
 /// One scene, both engines.
@@ -99,15 +106,44 @@ pub fn judge_with(
     scenes: &[(Generated, Ours, PathBuf)],
     settle_s: f64,
 ) -> Result<Vec<Judged>> {
+    run_judge(engine, python, script, scenes, settle_s, false)
+}
+
+/// [`judge_with`], and the engine's verdict from every nudged composed pose as well
+/// ([`MjScene::nudged`]; 8 more runs a free body: for verdict disagreements, to tell a
+/// verdict the engine itself flips under a 0.5 mm / 0.5° nudge from one it holds). Only the
+/// PhysX script answers it.
+pub fn judge_nudged(
+    engine: &str,
+    python: &str,
+    script: &Path,
+    scenes: &[(Generated, Ours, PathBuf)],
+    settle_s: f64,
+) -> Result<Vec<Judged>> {
+    run_judge(engine, python, script, scenes, settle_s, true)
+}
+
+fn run_judge(
+    engine: &str,
+    python: &str,
+    script: &Path,
+    scenes: &[(Generated, Ours, PathBuf)],
+    settle_s: f64,
+    nudge: bool,
+) -> Result<Vec<Judged>> {
     let list: Vec<serde_json::Value> = scenes
         .iter()
         .map(|(_, o, d)| {
-            serde_json::json!({
+            let mut e = serde_json::json!({
                 "dir": d,
                 "diagonals": o.bodies.iter().map(|b| (b.name.clone(), b.diagonal)).collect::<BTreeMap<_, _>>(),
                 "settled": o.passed,
                 "settle_s": settle_s,
-            })
+            });
+            if nudge {
+                e["nudge"] = true.into();
+            }
+            e
         })
         .collect();
     let input = std::env::temp_dir().join(format!(

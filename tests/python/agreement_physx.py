@@ -12,7 +12,11 @@ Same input and output as agreement_mujoco.py (one JSON line per scene on stdout)
   when all do; the turn over the settle part is reported (settle_deg, settle_q0, settle_q1 as
   w, x, y, z) for the caller's large-turn rule;
 - from scene.usda as exported (the settled pose): the worst displacement and turn of each body
-  over 2 s.
+  over 2 s;
+- when the entry says "nudge": true, also "nudged": PhysX's verdict by the same rule from the
+  composed pose nudged as our validator nudges it (each free body in turn: 0.5 deg about +-x,
+  +-y through its centre of mass, then 0.5 mm along +-x, +-y; 8 starts a body), so a caller
+  can tell a verdict PhysX itself would flip under a nudge from one it holds.
 Poses are PhysX's rigid-body poses, read every step of the rest parts (every 24th of the settle part) (the export puts the body frame at the
 centre of mass). Time step 1/240 s, PhysX's defaults otherwise (what scene.usda says).
 Engine chatter goes to stderr.
@@ -36,6 +40,10 @@ FROM_SETTLED_S = 2.0
 # 3x the whole judge (4 ms a read, 0.15 ms a step, ovphysx CPU, 2-body scene) and gives the
 # same verdicts.
 SETTLE_READ_EVERY = 24
+# An entry with "nudge": true also gets PhysX's verdict from nudged composed poses, as
+# src/validate/nudge.rs nudges ours (NUDGE_M, NUDGE_DEG there).
+NUDGE_M = 5e-4
+NUDGE_DEG = 0.5
 
 
 # The PhysX driver's helpers (this folder is the script's own, first on sys.path).
@@ -122,27 +130,75 @@ def dynamic_only(poses, names):
     return {p: v for p, v in poses.items() if p in names}
 
 
+def composed_verdict(path, names, diag, settle_s):
+    """The verdict rule from the pose of the file at `path`: (passed, finite, composed poses,
+    poses after the settle part, settle drift, rest part's worst) of every free body."""
+    r = Run(path)
+    composed = dynamic_only(r.poses(), names)
+    _, finite1 = r.run(settle_s, composed, every=SETTLE_READ_EVERY)
+    after = r.poses()
+    settle = {p: float(np.linalg.norm(after[p][0] - composed[p][0])) for p in composed}
+    rest, finite2 = r.run(REST_S, {p: after[p] for p in composed})
+    r.close()
+    passed = finite1 and finite2
+    for p in composed:
+        ok = settle[p] <= 0.10 * diag.get(names[p], float("inf")) and rest[p][0] <= 1e-3 and rest[p][1] <= 1.0
+        passed = passed and ok
+    return passed, finite1 and finite2, composed, after, settle, rest
+
+
+def nudged_verdicts(scene_dir, composed_path, names, diag, settle_s):
+    """PhysX's own verdict from the composed pose nudged as ours is (src/validate/nudge.rs
+    `nudged_poses`): each free body in turn turned by NUDGE_DEG about world +x, -x, +y, -y
+    through its centre of mass (the prim's origin: the export puts the body frame there), then
+    shifted by NUDGE_M along +x, -x, +y, -y; 8 starts a free body, in that order."""
+    from pxr import Gf, Sdf
+
+    out = []
+    path = os.path.join(scene_dir, "scene_nudged.usda")
+    axes = [(1, 0, 0), (-1, 0, 0), (0, 1, 0), (0, -1, 0)]
+    for prim_path in names:
+        for kind in range(2):
+            for ax in axes:
+                # A fresh copy of the composed layer each time, edited as a layer (no stage:
+                # its object references resolve only beside scene.usda).
+                layer = Sdf.Layer.CreateAnonymous(".usda")
+                layer.TransferContent(Sdf.Layer.FindOrOpen(composed_path))
+                if kind == 0:
+                    spec = layer.GetAttributeAtPath(prim_path + ".xformOp:orient")
+                    turn = Gf.Rotation(Gf.Vec3d(*ax), NUDGE_DEG).GetQuat()
+                    spec.default = type(spec.default)(turn * Gf.Quatd(spec.default))
+                else:
+                    spec = layer.GetAttributeAtPath(prim_path + ".xformOp:translate")
+                    t = spec.default
+                    spec.default = type(t)(t[0] + NUDGE_M * ax[0], t[1] + NUDGE_M * ax[1], t[2])
+                # Written beside scene.usda so the object references resolve.
+                layer.Export(path)
+                try:
+                    out.append(bool(composed_verdict(path, names, diag, settle_s)[0]))
+                finally:
+                    os.remove(path)
+    return out
+
+
 def judge(entry):
     t0 = time.time()
     d = entry["dir"]
     diag = entry["diagonals"]
+    settle_s = entry.get("settle_s", SETTLE_S)
     composed_path, names = composed_copy(d)
     out = {}
+    nudged = None
     try:
-        r = Run(composed_path)
-        composed = dynamic_only(r.poses(), names)
-        _, finite1 = r.run(entry.get("settle_s", SETTLE_S), composed, every=SETTLE_READ_EVERY)
-        after = r.poses()
-        settle = {p: float(np.linalg.norm(after[p][0] - composed[p][0])) for p in composed}
-        rest, finite2 = r.run(REST_S, {p: after[p] for p in composed})
-        r.close()
+        passed, finite12, composed, after, settle, rest = composed_verdict(
+            composed_path, names, diag, settle_s
+        )
+        if entry.get("nudge"):
+            nudged = nudged_verdicts(d, composed_path, names, diag, settle_s)
     finally:
         os.remove(composed_path)
-    passed = finite1 and finite2
     for p in composed:
         n = names[p]
-        ok = settle[p] <= 0.10 * diag.get(n, float("inf")) and rest[p][0] <= 1e-3 and rest[p][1] <= 1.0
-        passed = passed and ok
         q0, q1 = wxyz(composed[p][1]), wxyz(after[p][1])
         out[n] = {
             "settle_m": settle[p],
@@ -160,13 +216,16 @@ def judge(entry):
     for p in start:
         out[names[p]]["from_settled_m"] = worst[p][0]
         out[names[p]]["from_settled_deg"] = worst[p][1]
-    return {
+    res = {
         "dir": d,
         "passed": bool(passed),
-        "finite": bool(finite1 and finite2 and finite3),
+        "finite": bool(finite12 and finite3),
         "bodies": out,
         "seconds": time.time() - t0,
     }
+    if nudged is not None:
+        res["nudged"] = nudged
+    return res
 
 
 def main():
