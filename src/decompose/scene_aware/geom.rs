@@ -12,6 +12,9 @@ use parry3d_f64::query::{Ray, RayCast};
 use parry3d_f64::shape::{ConvexPolyhedron, TriMesh, TriMeshFlags};
 use rayon::prelude::*;
 
+pub use super::fps::farthest_points;
+pub use super::vertex_set::distinct_sorted;
+
 /// A mesh prepared for queries, with per-triangle and per-vertex data.
 pub struct Surface {
     /// The mesh (winding flipped when it enclosed a negative volume, so normals face out).
@@ -417,62 +420,6 @@ pub fn distance(a: &ConvexPolyhedron, b: &ConvexPolyhedron) -> f64 {
     parry3d_f64::query::distance(&id, a, &id, b)
         .map(|d| d.distance)
         .unwrap_or(0.0)
-}
-
-/// The values of `v`, each once, ascending, by a bitmap over their range: the vertex indices
-/// of a patch's triangles (each several times). Sorting them instead was most of the 10 % of
-/// the sneaker's decomposition spent in sorts.
-pub fn distinct_sorted(v: &[u32]) -> Vec<u32> {
-    let (Some(&lo), Some(&hi)) = (v.iter().min(), v.iter().max()) else {
-        return Vec::new();
-    };
-    let mut bits = vec![0u64; ((hi - lo) as usize >> 6) + 1];
-    for &x in v {
-        let i = (x - lo) as usize;
-        bits[i >> 6] |= 1 << (i & 63);
-    }
-    // Sized once: pushing into an empty vector reallocated it about log2(n) times.
-    let mut out = Vec::with_capacity(bits.iter().map(|b| b.count_ones() as usize).sum());
-    for (w, &b) in bits.iter().enumerate() {
-        let mut b = b;
-        while b != 0 {
-            out.push(lo + 64 * w as u32 + b.trailing_zeros());
-            b &= b - 1;
-        }
-    }
-    out
-}
-
-/// Farthest-point sampling: indices of at most `k` points of `pts`, the first the point
-/// farthest from their centroid (ties to the lower index). Deterministic.
-pub fn farthest_points(pts: &[P3], k: usize) -> Vec<usize> {
-    if pts.len() <= k {
-        return (0..pts.len()).collect();
-    }
-    let c = pts.iter().fold(V3::zeros(), |a, p| a + p.coords) / pts.len() as f64;
-    let first = (0..pts.len())
-        .max_by(|&i, &j| {
-            (pts[i].coords - c)
-                .norm_squared()
-                .total_cmp(&(pts[j].coords - c).norm_squared())
-                .then(j.cmp(&i))
-        })
-        .unwrap();
-    // Coordinates apart, padded to whole lanes of `LANES` points, each lane keeping its own
-    // farthest: the update and the maximum then run several points at a time in one pass
-    // (2× quicker than one pass for each on 500 points, 3× on 10,000). The farthest is then
-    // found by value, the first of equals (`fps::picks`, AVX2 where the processor has it).
-    const LANES: usize = super::fps::LANES;
-    let n = pts.len();
-    let padded = n.div_ceil(LANES) * LANES;
-    let (mut xs, mut ys, mut zs) = (vec![0.0; padded], vec![0.0; padded], vec![0.0; padded]);
-    for (i, p) in pts.iter().enumerate() {
-        (xs[i], ys[i], zs[i]) = (p.x, p.y, p.z);
-    }
-    // The padding is at distance 0: never the farthest.
-    let mut dist = vec![f64::INFINITY; padded];
-    dist[n..].fill(0.0);
-    super::fps::picks(&xs, &ys, &zs, &mut dist, first, k)
 }
 
 /// At most `k` vertices of a convex hull chosen greedily to lose the least: seeded by
