@@ -129,7 +129,7 @@ pub fn star_pieces(
 
 /// How far `v` lies under the boundary of `h` (which holds `c` and `v`), along the ray from
 /// `c` through `v`.
-pub(super) fn depth_under(h: &Hull, c: &P3, v: &P3) -> f64 {
+pub(in crate::decompose::scene_aware) fn depth_under(h: &Hull, c: &P3, v: &P3) -> f64 {
     let u = v - c;
     let r = u.norm();
     if !(r > 0.0) {
