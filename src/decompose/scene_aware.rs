@@ -120,6 +120,7 @@ mod solid;
 mod splits;
 mod star;
 mod unfill;
+mod vertex_set;
 
 pub use engine::SceneAware;
 pub use report::{ObjectReport, SceneAwareReport};
@@ -130,7 +131,7 @@ use star::{star, star_on_slabs, star_with_patches};
 use super::{DecomposeOptions, Hull};
 use crate::mesh::{Mesh, P3, V3};
 use contacts::*;
-use geom::{clip, distinct_sorted, farthest_points, greedy_hull, polyhedron, Surface};
+use geom::{clip, greedy_hull, polyhedron, Surface};
 use memo::*;
 use object::*;
 use parts::*;

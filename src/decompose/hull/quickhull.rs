@@ -77,6 +77,24 @@ impl Facet {
     }
 }
 
+/// Of `facets`, the one that sees `point` farthest (parry's loop, written twice there: the
+/// two-facet start and the undecidable points): the first strictly farther than those before
+/// it and than 0, or `None` when none sees it.
+fn farthest_seeing(facets: &[Facet], point: usize, points: &[Vector3]) -> Option<usize> {
+    let mut furthest = None;
+    let mut furthest_dist = 0.0;
+    for (i, f) in facets.iter().enumerate() {
+        if f.can_see_point(point, points) {
+            let distance = f.distance_to_point(point, points);
+            if distance > furthest_dist {
+                furthest = Some(i);
+                furthest_dist = distance;
+            }
+        }
+    }
+    furthest
+}
+
 /// The buffers of one thread's hulls.
 #[derive(Default)]
 struct Work {
@@ -287,19 +305,8 @@ impl Work {
             {
                 continue;
             }
-            let mut furthest = usize::MAX;
-            let mut furthest_dist = 0.0;
-            for (i, f) in self.facets[..2].iter().enumerate() {
-                if f.can_see_point(point, points) {
-                    let distance = f.distance_to_point(point, points);
-                    if distance > furthest_dist {
-                        furthest = i;
-                        furthest_dist = distance;
-                    }
-                }
-            }
-            if furthest != usize::MAX {
-                self.facets[furthest].add_visible_point(point, points)?;
+            if let Some(f) = farthest_seeing(&self.facets[..2], point, points) {
+                self.facets[f].add_visible_point(point, points)?;
             } else {
                 self.undecidable.push(point);
             }
@@ -455,20 +462,9 @@ impl Work {
 
         let mut i = 0;
         while i != self.undecidable.len() {
-            let mut furthest = usize::MAX;
-            let mut furthest_dist = 0.0;
             let undecidable_point = self.undecidable[i];
-            for (j, f) in new.iter().enumerate() {
-                if f.can_see_point(undecidable_point, points) {
-                    let distance = f.distance_to_point(undecidable_point, points);
-                    if distance > furthest_dist {
-                        furthest = j;
-                        furthest_dist = distance;
-                    }
-                }
-            }
-            if furthest != usize::MAX {
-                new[furthest].add_visible_point(undecidable_point, points)?;
+            if let Some(f) = farthest_seeing(new, undecidable_point, points) {
+                new[f].add_visible_point(undecidable_point, points)?;
                 let _ = self.undecidable.swap_remove(i);
             } else {
                 i += 1;

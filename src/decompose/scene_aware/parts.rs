@@ -4,6 +4,7 @@
 //! Entry points: [`build_part`], [`build_part_below`], [`build_new_part`], [`deviation`],
 //! [`deviation_until`], [`inflate`].
 
+use super::vertex_set::VertexSet;
 use super::*;
 
 /// Derived absolute parameters of one object.
@@ -237,8 +238,14 @@ pub(super) fn build_new_part(
     bound: f64,
 ) -> Option<Part> {
     let mut normal = V3::zeros();
+    // The range of the patch's vertex indices, for its vertex sets.
+    let (mut lo, mut hi) = (u32::MAX, 0);
     for &t in &tris {
         normal += s.tri_normal[t as usize] * s.tri_area[t as usize];
+        for k in s.mesh.triangles[t as usize] {
+            lo = lo.min(k);
+            hi = hi.max(k);
+        }
     }
     if normal.norm() > 0.0 {
         normal.normalize_mut();
@@ -249,23 +256,23 @@ pub(super) fn build_new_part(
             .then(b.cmp(&a))
     })?;
     let axis = s.tri_normal[axis_t as usize];
-    let (mut pos, mut neg): (Vec<u32>, Vec<u32>) = (Vec::new(), Vec::new());
+    // The vertices of the triangles facing along `axis` and of the others, each once.
+    let (mut pos, mut neg) = (VertexSet::new(lo, hi), VertexSet::new(lo, hi));
     let (mut a_pos, mut a_neg) = (0.0, 0.0);
     for &t in &tris {
         let tri = s.mesh.triangles[t as usize];
         if s.tri_normal[t as usize].dot(&axis) >= 0.0 {
-            pos.extend(tri);
+            tri.into_iter().for_each(|k| pos.insert(k));
             a_pos += s.tri_area[t as usize];
         } else {
-            neg.extend(tri);
+            tri.into_iter().for_each(|k| neg.insert(k));
             a_neg += s.tri_area[t as usize];
         }
     }
     let two_sided = a_pos.min(a_neg) >= 0.1 * (a_pos + a_neg);
     // Up to `n_outer` of the vertices `v` (distinct, ascending), spread out.
     let pick = |v: &[u32]| -> Vec<u32> {
-        let pts: Vec<P3> = v.iter().map(|&i| s.mesh.vertices[i as usize]).collect();
-        farthest_points(&pts, p.n_outer)
+        super::fps::farthest_of(v.len(), |i| s.mesh.vertices[v[i] as usize], p.n_outer)
             .into_iter()
             .map(|k| v[k])
             .collect()
@@ -273,33 +280,29 @@ pub(super) fn build_new_part(
     let mut all: Vec<P3> = Vec::with_capacity(2 * p.n_outer);
     let mut outer = Vec::with_capacity(2 * p.n_outer);
     if two_sided {
-        let (pos, neg) = (distinct_sorted(&pos), distinct_sorted(&neg));
+        let (pos, neg) = (pos.to_vec(), neg.to_vec());
         for v in pick(&pos).into_iter().chain(pick(&neg)) {
             outer.push(s.mesh.vertices[v as usize]);
         }
         all.extend_from_slice(&outer);
         normal = V3::zeros();
     } else {
-        pos.extend(neg);
+        pos.union_with(&neg);
+        let set = pos.ranked();
         // Vertex normals from this patch's triangles only: at a crease (a floor meeting a
         // wall) the whole-mesh normal would push the copies sideways, along the patch.
-        let vs = distinct_sorted(&pos);
+        let vs = set.to_vec();
         let mut vn = vec![V3::zeros(); vs.len()];
         for &t in &tris {
             let w = s.tri_normal[t as usize] * s.tri_area[t as usize];
             for k in s.mesh.triangles[t as usize] {
-                if let Ok(i) = vs.binary_search(&k) {
-                    vn[i] += w;
-                }
+                vn[set.rank(k)] += w;
             }
         }
         let ray_max = p.d_max / 0.45 * 1.01;
         for v in pick(&vs) {
             let q = s.mesh.vertices[v as usize];
-            let mut n = vs
-                .binary_search(&v)
-                .map(|i| vn[i])
-                .unwrap_or_else(|_| V3::zeros());
+            let mut n = vn[set.rank(v)];
             n = if n.norm() > 0.0 {
                 n.normalize()
             } else {

@@ -37,18 +37,26 @@ pub(super) fn star(
     opts: &DecomposeOptions,
     budget: usize,
     support: &[u32],
-    slabs: Option<(&[Hull], f64)>,
+    slabs: Option<&Slabs>,
     seen_only: bool,
 ) -> Option<(f64, Vec<Part>)> {
     if budget < 2 {
         return None;
     }
-    let c = centre(s)?;
-    let probes = s.samples(HIDDEN_PROBES, HIDDEN_SEED);
-    // With slabs the caller ([`star_on_slabs`]) has checked this once for its three tries.
-    if slabs.is_none() && hidden(s, &c, &probes, 10.0 * p.tol) > HIDDEN_MAX {
-        return None;
-    }
+    // With slabs the caller ([`star_on_slabs`]) has found the centre and the probes, and
+    // checked what hides, once for its three tries.
+    let own;
+    let (c, probes) = match slabs {
+        Some(sl) => (sl.centre, sl.probes),
+        None => {
+            let c = centre(s)?;
+            own = s.samples(HIDDEN_PROBES, HIDDEN_SEED);
+            if hidden(s, &c, &own, 10.0 * p.tol) > HIDDEN_MAX {
+                return None;
+            }
+            (c, &own[..])
+        }
+    };
     // As many directions as `budget` pieces hold, spread two ways (see `geom::ray_frames`),
     // the closer at the 95th percentile kept. Pieces may bulge a tolerance past the surface
     // seen, or more (×1.5 each time) when that takes more pieces than the budget.
@@ -56,7 +64,7 @@ pub(super) fn star(
     let n = budget * cap / 2;
     let level = |h: &Hull| flat_over(s, p, support, h);
     let level = (!support.is_empty()).then_some(&level as &(dyn Fn(&Hull) -> bool + Sync));
-    let (extra, floor) = slabs.unwrap_or((&[], f64::INFINITY));
+    let (extra, floor) = slabs.map_or((&[][..], f64::INFINITY), |sl| (sl.hulls, sl.floor));
     // The pieces' hulls with the slabs: what the reach test and the 95th percentile measure.
     let with_slabs = |pieces: &[(Hull, Vec<P3>, V3)]| -> Vec<Hull> {
         pieces
@@ -125,6 +133,16 @@ pub(super) fn star(
         .map(|(hull, outer, normal)| Part::piece(hull, outer, normal, dev))
         .collect();
     Some((p95, parts))
+}
+
+/// What [`star_on_slabs`] hands [`star`]: the slabs' hulls and the height under them
+/// (`floor`), and the centre of volume and the surface probes it has already found (the same
+/// [`centre`] and samples `star` finds alone).
+pub(super) struct Slabs<'a> {
+    hulls: &'a [Hull],
+    floor: f64,
+    centre: P3,
+    probes: &'a [P3],
 }
 
 /// The largest share of the surface [`star`] (and [`star_on_slabs`]) lets hide from the
@@ -317,7 +335,13 @@ pub(super) fn star_on_slabs(
             }
             let hulls = hulls_of(&slabs);
             let rest = budget.checked_sub(slabs.len())?;
-            let (_, mut parts) = star(s, p, opts, rest, support, Some((&hulls, floor)), false)?;
+            let under = Slabs {
+                hulls: &hulls,
+                floor,
+                centre: c,
+                probes: &probes,
+            };
+            let (_, mut parts) = star(s, p, opts, rest, support, Some(&under), false)?;
             parts.extend(slabs);
             let (p95, _) = distance_stats(s, &hulls_of(&parts))?;
             Some((p95, parts))
