@@ -73,6 +73,33 @@ pub struct SimBody {
     pub fixed: bool,
 }
 
+impl SimBody {
+    /// A dynamic solid box of full extents `e` (m) and uniform density, centred on its body
+    /// frame, at `pose`, with friction `friction` (the tests' blocks, plates and walls).
+    pub fn cuboid(
+        name: &str,
+        e: crate::mesh::V3,
+        mass: f64,
+        pose: Isometry3<f64>,
+        friction: f64,
+    ) -> Self {
+        SimBody {
+            name: name.into(),
+            pose,
+            hulls: vec![crate::shapes::cuboid(e)],
+            mass,
+            com: P3::origin(),
+            inertia: Matrix3::from_diagonal(&Vector3::new(
+                mass / 12.0 * (e.y * e.y + e.z * e.z),
+                mass / 12.0 * (e.x * e.x + e.z * e.z),
+                mass / 12.0 * (e.x * e.x + e.y * e.y),
+            )),
+            friction,
+            fixed: false,
+        }
+    }
+}
+
 /// Simulation parameters and pass/fail thresholds. Distances in metres, angles in degrees.
 #[derive(Clone, Debug, Serialize)]
 pub struct SettleOptions {
