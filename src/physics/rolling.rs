@@ -66,7 +66,17 @@ impl Rolling {
                 if i == j {
                     continue;
                 }
-                let impulse: Real = m.points.iter().map(|p| p.data.impulse).sum();
+                // Only the points handed to the solver this step: a manifold point left out of
+                // it (parry's manifold has up to one more) keeps the impulse it inherited from
+                // the point it was matched to, stale; on the 0.01° incline those made `N`
+                // 1.41–1.54× the weight (docs/agreement.md "Fourteenth stop").
+                let impulse: Real = m
+                    .data
+                    .solver_contacts
+                    .iter()
+                    .filter_map(|c| m.points.get(c.contact_indices()[0] as usize))
+                    .map(|p| p.data.impulse)
+                    .sum();
                 if impulse <= 0.0 {
                     continue;
                 }

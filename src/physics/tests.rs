@@ -19,16 +19,7 @@ fn box_inertia(m: f64, e: V3) -> Matrix3<f64> {
 }
 
 fn box_body(name: &str, e: V3, mass: f64, pose: Isometry3<f64>) -> SimBody {
-    SimBody {
-        name: name.into(),
-        pose,
-        hulls: vec![cuboid(e)],
-        mass,
-        com: P3::origin(),
-        inertia: box_inertia(mass, e),
-        friction: 0.6,
-        fixed: false,
-    }
+    SimBody::cuboid(name, e, mass, pose, 0.6)
 }
 
 fn sphere_body(name: &str, r: f64, mass: f64, pose: Isometry3<f64>) -> SimBody {
