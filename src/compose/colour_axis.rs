@@ -81,16 +81,6 @@ impl ColourProfile {
     fn hi(&self) -> f64 {
         self.lo + self.bin * self.colour.len() as f64
     }
-
-    /// The colour at axial coordinate `u`: `None` beyond the ends, `Some(None)` in a bin with
-    /// too few points.
-    fn at(&self, u: f64) -> Option<Option<[f64; 3]>> {
-        if u < self.lo || u >= self.hi() {
-            return None;
-        }
-        let k = (((u - self.lo) / self.bin) as usize).min(self.colour.len() - 1);
-        Some(self.colour[k])
-    }
 }
 
 /// The search of [`fit`].
@@ -132,25 +122,16 @@ pub struct ProfileFit {
     pub offset: f64,
 }
 
-/// The cost of mapping `model` onto `guidance` at `scale`, direction `sign` and offset `b`
-/// (guidance coordinate u ↦ model coordinate sign·u/scale + b). `stop`: a sum of residuals
-/// beyond which the placement cannot win; the sum stops there and the cost is infinite (the
-/// residuals are never negative, so the search's minimum is the same).
-#[allow(clippy::too_many_arguments)]
-fn cost(
-    model: &ColourProfile,
-    guidance: &ColourProfile,
-    scale: f64,
-    sign: f64,
-    b: f64,
-    cap: f64,
-    stop: f64,
-) -> f64 {
-    let (mut sum, mut n) = (0.0, 0usize);
-    for (k, g) in guidance.colour.iter().enumerate() {
-        let Some(g) = g else { continue };
-        n += 1;
-        let u = sign * guidance.centre(k) / scale + b;
+/// The cost of mapping `model` onto the guidance at offset `b`: `mapped` holds each filled
+/// guidance bin's model coordinate before the offset (sign·centre/scale) and its colour, so a
+/// bin's model coordinate is `mapped + b` (guidance coordinate u ↦ model coordinate
+/// sign·u/scale + b, the same operations in the same order as computing it whole). `stop`: a sum
+/// of residuals beyond which the placement cannot win; the sum stops there and the cost is
+/// infinite (the residuals are never negative, so the search's minimum is the same).
+fn cost(model: &ModelBins, mapped: &[(f64, [f64; 3])], b: f64, cap: f64, stop: f64) -> f64 {
+    let mut sum = 0.0;
+    for (w, g) in mapped {
+        let u = w + b;
         sum += match model.at(u) {
             None => cap,
             Some(None) => 0.0,
@@ -162,10 +143,31 @@ fn cost(
             return f64::INFINITY;
         }
     }
-    if n == 0 {
+    if mapped.is_empty() {
         f64::INFINITY
     } else {
-        sum / n as f64
+        sum / mapped.len() as f64
+    }
+}
+
+/// A model profile's look-up, its end computed once.
+struct ModelBins<'a> {
+    lo: f64,
+    hi: f64,
+    bin: f64,
+    colour: &'a [Option<[f64; 3]>],
+}
+
+impl ModelBins<'_> {
+    /// The colour at axial coordinate `u`: `None` beyond the ends, `Some(None)` in a bin with
+    /// too few points.
+    #[inline(always)]
+    fn at(&self, u: f64) -> Option<Option<[f64; 3]>> {
+        if u < self.lo || u >= self.hi {
+            return None;
+        }
+        let k = (((u - self.lo) / self.bin) as usize).min(self.colour.len() - 1);
+        Some(self.colour[k])
     }
 }
 
@@ -178,6 +180,13 @@ pub fn fit(model: &ColourProfile, guidance: &ColourProfile, o: &FitOptions) -> O
     }
     let steps = o.steps.max(2);
     let filled = guidance.colour.iter().filter(|c| c.is_some()).count();
+    let bins = ModelBins {
+        lo: model.lo,
+        hi: model.hi(),
+        bin: model.bin,
+        colour: &model.colour,
+    };
+    let mut mapped: Vec<(f64, [f64; 3])> = Vec::with_capacity(filled);
     let mut per_scale = Vec::with_capacity(steps);
     for i in 0..steps {
         let t = i as f64 / (steps - 1) as f64;
@@ -190,10 +199,16 @@ pub fn fit(model: &ColourProfile, guidance: &ColourProfile, o: &FitOptions) -> O
             let b_lo = model.lo - gmax;
             let b_hi = model.hi() - gmin;
             let step = model.bin / 4.0;
+            mapped.clear();
+            for (k, g) in guidance.colour.iter().enumerate() {
+                if let Some(g) = g {
+                    mapped.push((sign * guidance.centre(k) / s, *g));
+                }
+            }
             let mut b = b_lo;
             while b <= b_hi {
                 let stop = best.0 * filled as f64 * (1.0 + 1e-12);
-                let c = cost(model, guidance, s, sign, b, o.cap, stop);
+                let c = cost(&bins, &mapped, b, o.cap, stop);
                 if c < best.0 {
                     best = (c, sign as i8, b);
                 }
