@@ -7,9 +7,9 @@
 //! Run: `cargo run --release --example bench_settle [solver_iterations=N] [pgs_iterations=N]`
 
 use interact3d::mesh::{Mesh, P3, V3};
-use interact3d::physics::{settle, simulate, SettleOptions, SimBody};
+use interact3d::physics::{box_inertia, settle, simulate, SettleOptions, SimBody};
 use interact3d::shapes::cuboid;
-use nalgebra::{Isometry3, Matrix3, Matrix4, Vector3};
+use nalgebra::{Isometry3, Matrix4};
 use std::f64::consts::PI;
 
 #[path = "common/timing.rs"]
@@ -68,14 +68,6 @@ fn block() -> SimBody {
         friction: 0.6,
         fixed: false,
     }
-}
-
-fn box_inertia(m: f64, e: V3) -> Matrix3<f64> {
-    Matrix3::from_diagonal(&Vector3::new(
-        m / 12.0 * (e.y * e.y + e.z * e.z),
-        m / 12.0 * (e.x * e.x + e.z * e.z),
-        m / 12.0 * (e.x * e.x + e.y * e.y),
-    ))
 }
 
 fn main() {

@@ -95,25 +95,15 @@ impl Sim<'_> {
 mod tests {
     use super::*;
     use crate::mesh::V3;
-    use crate::shapes::cuboid;
     use std::f64::consts::PI;
 
     /// A box of extents `e` and `mass` standing with its bottom face at height `bottom`.
     fn block(name: &str, e: [f64; 3], mass: f64, x: f64, bottom: f64, fixed: bool) -> SimBody {
         let e = V3::new(e[0], e[1], e[2]);
+        let pose = Isometry3::translation(x, 0.0, bottom + e.z / 2.0);
         SimBody {
-            name: name.into(),
-            pose: Isometry3::translation(x, 0.0, bottom + e.z / 2.0),
-            hulls: vec![cuboid(e)],
-            mass,
-            com: P3::origin(),
-            inertia: Matrix3::from_diagonal(&Vector3::new(
-                mass / 12.0 * (e.y * e.y + e.z * e.z),
-                mass / 12.0 * (e.x * e.x + e.z * e.z),
-                mass / 12.0 * (e.x * e.x + e.y * e.y),
-            )),
-            friction: 0.6,
             fixed,
+            ..SimBody::cuboid(name, e, mass, pose, 0.6)
         }
     }
 

@@ -89,15 +89,21 @@ impl SimBody {
             hulls: vec![crate::shapes::cuboid(e)],
             mass,
             com: P3::origin(),
-            inertia: Matrix3::from_diagonal(&Vector3::new(
-                mass / 12.0 * (e.y * e.y + e.z * e.z),
-                mass / 12.0 * (e.x * e.x + e.z * e.z),
-                mass / 12.0 * (e.x * e.x + e.y * e.y),
-            )),
+            inertia: box_inertia(mass, e),
             friction,
             fixed: false,
         }
     }
+}
+
+/// The inertia tensor about its centre of a solid box of full extents `e` (m) and `mass` (kg),
+/// in the box's frame.
+pub fn box_inertia(mass: f64, e: crate::mesh::V3) -> Matrix3<f64> {
+    Matrix3::from_diagonal(&Vector3::new(
+        mass / 12.0 * (e.y * e.y + e.z * e.z),
+        mass / 12.0 * (e.x * e.x + e.z * e.z),
+        mass / 12.0 * (e.x * e.x + e.y * e.y),
+    ))
 }
 
 /// Simulation parameters and pass/fail thresholds. Distances in metres, angles in degrees.

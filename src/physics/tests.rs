@@ -10,14 +10,6 @@ fn at(x: f64, y: f64, z: f64) -> Isometry3<f64> {
     Isometry3::translation(x, y, z)
 }
 
-fn box_inertia(m: f64, e: V3) -> Matrix3<f64> {
-    Matrix3::from_diagonal(&Vector3::new(
-        m / 12.0 * (e.y * e.y + e.z * e.z),
-        m / 12.0 * (e.x * e.x + e.z * e.z),
-        m / 12.0 * (e.x * e.x + e.y * e.y),
-    ))
-}
-
 fn box_body(name: &str, e: V3, mass: f64, pose: Isometry3<f64>) -> SimBody {
     SimBody::cuboid(name, e, mass, pose, 0.6)
 }
