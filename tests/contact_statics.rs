@@ -16,9 +16,9 @@
 //!   rolling friction's μ_r g cos θ / (1.5 r) (`rolling_friction`).
 
 use interact3d::mesh::{P3, V3};
-use interact3d::physics::{simulate, PoseRecord, SettleOptions, SimBody};
+use interact3d::physics::{cylinder_inertia, simulate, PoseRecord, SettleOptions, SimBody};
 use interact3d::shapes::{cuboid, cylinder};
-use nalgebra::{Isometry3, Matrix3, Quaternion, Translation3, UnitQuaternion, Vector3};
+use nalgebra::{Isometry3, Quaternion, Translation3, UnitQuaternion, Vector3};
 
 /// The library's settle options with sleeping and the start kick off.
 fn awake() -> SettleOptions {
@@ -242,11 +242,7 @@ fn a_cylinder_rocking_on_its_rim_never_tilts_past_its_release_angle() {
         hulls: vec![cylinder(r, h, 32)],
         mass: m,
         com: P3::origin(),
-        inertia: Matrix3::from_diagonal(&Vector3::new(
-            m * (3.0 * r * r + h * h) / 12.0,
-            m * (3.0 * r * r + h * h) / 12.0,
-            m * r * r / 2.0,
-        )),
+        inertia: cylinder_inertia(m, r, h),
         friction: 0.6,
         fixed: false,
     };
@@ -318,11 +314,7 @@ fn cylinder_on_incline(deg: f64, sides: usize) -> Vec<SimBody> {
         hulls: vec![cylinder(r, l, sides)],
         mass: m,
         com: P3::origin(),
-        inertia: Matrix3::from_diagonal(&Vector3::new(
-            m * (3.0 * r * r + l * l) / 12.0,
-            m * (3.0 * r * r + l * l) / 12.0,
-            m * r * r / 2.0,
-        )),
+        inertia: cylinder_inertia(m, r, l),
         friction: 0.6,
         fixed: false,
     };

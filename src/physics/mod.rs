@@ -96,6 +96,13 @@ impl SimBody {
     }
 }
 
+/// The inertia tensor about its centre of a solid cylinder of radius `r`, length `l` (m) and
+/// `mass` (kg), its axis along the frame's z.
+pub fn cylinder_inertia(mass: f64, r: f64, l: f64) -> Matrix3<f64> {
+    let across = mass * (3.0 * r * r + l * l) / 12.0;
+    Matrix3::from_diagonal(&Vector3::new(across, across, mass * r * r / 2.0))
+}
+
 /// The inertia tensor about its centre of a solid box of full extents `e` (m) and `mass` (kg),
 /// in the box's frame.
 pub fn box_inertia(mass: f64, e: crate::mesh::V3) -> Matrix3<f64> {

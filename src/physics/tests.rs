@@ -379,11 +379,7 @@ fn a_plate_of_pie_slices_resting_on_the_floor_stays_put() {
         hulls,
         mass,
         com: P3::new(0.0, 0.0, t / 2.0),
-        inertia: Matrix3::from_diagonal(&Vector3::new(
-            mass * (3.0 * r * r + t * t) / 12.0,
-            mass * (3.0 * r * r + t * t) / 12.0,
-            mass * r * r / 2.0,
-        )),
+        inertia: cylinder_inertia(mass, r, t),
         friction: 0.6,
         fixed: false,
     };
