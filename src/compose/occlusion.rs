@@ -112,30 +112,29 @@ fn box_bins(lo: &V3, hi: &V3) -> u64 {
 /// The blockers in a tree of boxes (median splits, leaves of a few points). A box whose
 /// directions from a query may fall only in bins already set ([`box_bins`]) is skipped, and one
 /// whose every direction falls in one bin sets it, without their points being read: the same
-/// mask as binning every blocker ([`mask_of`]), the bins being OR-ed in any order.
+/// mask as binning every blocker ([`mask_of`]), the bins being OR-ed in any order. No tree when
+/// a coordinate is not finite: every blocker is then binned one by one.
 struct BlockerBoxes {
-    /// The blockers in tree order.
+    /// The blockers, in tree order when there is a tree.
     points: Vec<P3>,
-    /// (lo, hi, start, end, first child; 0 for a leaf).
+    /// (lo, hi, start, end, first child; 0 for a leaf); empty without a tree.
     nodes: Vec<(P3, P3, u32, u32, u32)>,
 }
 
 impl BlockerBoxes {
     const LEAF: usize = 8;
 
-    fn new(blockers: &[P3]) -> Option<BlockerBoxes> {
-        if blockers.iter().any(|p| !p.iter().all(|x| x.is_finite())) {
-            return None;
-        }
+    fn new(blockers: Vec<P3>) -> BlockerBoxes {
+        let finite = blockers.iter().all(|p| p.iter().all(|x| x.is_finite()));
         let mut t = BlockerBoxes {
-            points: blockers.to_vec(),
+            points: blockers,
             nodes: Vec::new(),
         };
-        if !t.points.is_empty() {
+        if finite && !t.points.is_empty() {
             t.nodes.push((P3::origin(), P3::origin(), 0, 0, 0));
             t.build(0, 0, t.points.len());
         }
-        Some(t)
+        t
     }
 
     fn build(&mut self, node: usize, start: usize, end: usize) {
@@ -161,10 +160,10 @@ impl BlockerBoxes {
     }
 
     fn mask_from(&self, q: &P3) -> u64 {
-        let mut m = 0u64;
         if self.nodes.is_empty() {
-            return m;
+            return mask_of(&self.points, q);
         }
+        let mut m = 0u64;
         let mut stack = vec![0u32];
         while let Some(n) = stack.pop() {
             let (lo, hi, start, end, left) = self.nodes[n as usize];
@@ -206,10 +205,8 @@ fn bin_centres() -> [V3; BINS] {
 /// The other objects of a scene as blockers, seen from the neighbourhood of one object: a
 /// lazily filled grid of blocked-direction masks.
 pub struct Occlusion<'a> {
-    blockers: Vec<P3>,
-    /// The blockers in boxes, for [`Occlusion::mask_from`]; `None` when a coordinate is not
-    /// finite (then every blocker is binned one by one).
-    boxes: Option<BlockerBoxes>,
+    /// The blockers in boxes, for [`Occlusion::mask`].
+    blockers: BlockerBoxes,
     /// The placed objects as solids: a point inside one, deeper than `tolerance`, is not hidden
     /// but penetrating, which explains nothing.
     solids: Option<(&'a AnchorField, f64)>,
@@ -231,8 +228,7 @@ impl<'a> Occlusion<'a> {
         let dims = [0, 1, 2].map(|k| ((ext[k] / cell).ceil() as usize).clamp(1, 200));
         let n = dims[0] * dims[1] * dims[2];
         Occlusion {
-            boxes: BlockerBoxes::new(&blockers),
-            blockers,
+            blockers: BlockerBoxes::new(blockers),
             solids: None,
             lo,
             cell,
@@ -247,13 +243,6 @@ impl<'a> Occlusion<'a> {
     pub fn with_solids(mut self, field: &'a AnchorField, tolerance: f64) -> Occlusion<'a> {
         self.solids = Some((field, tolerance));
         self
-    }
-
-    fn mask_from(&self, q: &P3) -> u64 {
-        match &self.boxes {
-            Some(b) => b.mask_from(q),
-            None => mask_of(&self.blockers, q),
-        }
     }
 
     /// The directions blocked from the centre of `q`'s cell; `None` outside the grid.
@@ -273,7 +262,7 @@ impl<'a> Occlusion<'a> {
                 self.lo.y + (idx[1] as f64 + 0.5) * self.cell,
                 self.lo.z + (idx[2] as f64 + 0.5) * self.cell,
             );
-            self.mask_from(&c)
+            self.blockers.mask_from(&c)
         }))
     }
 
@@ -290,7 +279,7 @@ impl<'a> Occlusion<'a> {
                 return true;
             }
         }
-        if self.blockers.is_empty() {
+        if self.blockers.points.is_empty() {
             return false;
         }
         let Some(m) = self.mask(q) else {
@@ -355,7 +344,7 @@ mod tests {
             }
         }
         for set in [&flat, &spread, &grid] {
-            let boxes = BlockerBoxes::new(set).unwrap();
+            let boxes = BlockerBoxes::new(set.clone());
             for q in &queries {
                 assert_eq!(boxes.mask_from(q), mask_of(set, q), "{q:?}");
             }
@@ -383,8 +372,11 @@ mod tests {
                 );
             }
         }
-        // A blocker that is not finite: every blocker binned one by one.
-        assert!(BlockerBoxes::new(&[P3::new(f64::NAN, 0.0, 0.0)]).is_none());
+        // A blocker that is not finite: no tree, every blocker binned one by one.
+        let odd = vec![P3::new(f64::NAN, 0.0, 0.0), P3::new(1.0, 0.0, 0.0)];
+        let boxes = BlockerBoxes::new(odd.clone());
+        assert!(boxes.nodes.is_empty());
+        assert_eq!(boxes.mask_from(&P3::origin()), mask_of(&odd, &P3::origin()));
     }
 
     #[test]
