@@ -208,14 +208,7 @@ fn main() {
         print_table("PhysX", &(0..0), &s);
         if nudge {
             print_spread(&nudged_px);
-            let within = physx_spread
-                .iter()
-                .filter(|(v, sp)| sp.includes(*v))
-                .count();
-            let split = physx_spread
-                .iter()
-                .filter(|(_, sp)| sp.undetermined())
-                .count();
+            let (within, split) = spread_counts(&physx_spread);
             println!(
                 "verdict disagreements where some nudged start (0.5 mm / 0.5 deg) of PhysX's \
                  gives our verdict: {within} of {} ({split} with PhysX's nudged verdicts split)",
@@ -284,11 +277,18 @@ fn physx_nudged(
         .collect()
 }
 
+/// Of (verdict, spread) pairs: those whose spread includes the verdict, and those whose spread
+/// is split.
+fn spread_counts(v: &[(bool, Spread)]) -> (usize, usize) {
+    let within = v.iter().filter(|(x, sp)| sp.includes(*x)).count();
+    let split = v.iter().filter(|(_, sp)| sp.undetermined()).count();
+    (within, split)
+}
+
 /// `--nudge`'s count: of the verdict disagreements, those whose engine verdict some nudged
 /// start of ours shares, and those whose nudged verdicts split.
 fn print_spread(nudged: &[(bool, Spread)]) {
-    let within = nudged.iter().filter(|(v, sp)| sp.includes(*v)).count();
-    let split = nudged.iter().filter(|(_, sp)| sp.undetermined()).count();
+    let (within, split) = spread_counts(nudged);
     println!(
         "verdict disagreements within our own nudged spread (0.5 mm / 0.5 deg): {within} of {} \
          ({split} with our nudged verdicts split)",
