@@ -56,14 +56,12 @@ fn decoded(bytes: &Arc<Vec<u8>>) -> Option<Arc<Image>> {
     {
         return Some(hit);
     }
-    let img = Arc::new(jpeg_reduced(bytes).or_else(|| {
-        let img = image::load_from_memory(bytes).ok()?.into_rgb8();
-        Some(Image {
-            w: img.width(),
-            h: img.height(),
-            px: img.into_raw(),
-        })
-    })?);
+    let img = image::load_from_memory(bytes).ok()?.into_rgb8();
+    let img = Arc::new(Image {
+        w: img.width(),
+        h: img.height(),
+        px: img.into_raw(),
+    });
     if let Ok(mut cache) = DECODED.lock() {
         if cache.len() >= DECODED_KEEP {
             cache.remove(0);
@@ -71,40 +69,6 @@ fn decoded(bytes: &Arc<Vec<u8>>) -> Option<Arc<Image>> {
         cache.push((bytes.clone(), img.clone()));
     }
     Some(img)
-}
-
-/// The side a JPEG texture is decoded down to (at least, on one axis): compose reads one texel
-/// per sample point and asks at most 5,000 points of a mesh, so a 512² decode still has ~50
-/// texels a sample (the atlas' empty space aside) — finer detail is never seen by the sampling.
-const JPEG_MIN_SIDE: u16 = 512;
-
-/// A JPEG decoded at 1/2, 1/4 or 1/8 scale in the IDCT (`jpeg_decoder::Decoder::scale`: the
-/// smallest factor that keeps one side ≥ [`JPEG_MIN_SIDE`]); each texel is then close to the
-/// mean of the full texels it covers. Entropy decoding is still whole, the IDCT and colour
-/// conversion shrink with the output: a 4096² texture costs a fraction of its full decode.
-/// `None` (the caller decodes in full) for anything but an 8-bit grey or RGB JPEG or on any
-/// decoder error. Deterministic: single-threaded integer IDCT.
-fn jpeg_reduced(bytes: &[u8]) -> Option<Image> {
-    if !bytes.starts_with(&[0xFF, 0xD8, 0xFF]) {
-        return None;
-    }
-    let mut dec = jpeg_decoder::Decoder::new(bytes);
-    dec.scale(JPEG_MIN_SIDE, JPEG_MIN_SIDE).ok()?;
-    let px = dec.decode().ok()?;
-    let info = dec.info()?;
-    let (w, h) = (u32::from(info.width), u32::from(info.height));
-    let n = w as usize * h as usize;
-    if n == 0 {
-        return None;
-    }
-    let px = match info.pixel_format {
-        jpeg_decoder::PixelFormat::RGB24 if px.len() == 3 * n => px,
-        jpeg_decoder::PixelFormat::L8 if px.len() == n => {
-            px.iter().flat_map(|&l| [l, l, l]).collect()
-        }
-        _ => return None,
-    };
-    Some(Image { w, h, px })
 }
 
 /// Empty the decoded-texture cache (benchmarks time a cold start with it).
@@ -248,114 +212,5 @@ impl Cloud {
     pub fn centroid(&self) -> P3 {
         let n = self.points.len().max(1) as f64;
         P3::from(self.points.iter().fold(V3::zeros(), |a, p| a + p.coords) / n)
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use image::codecs::jpeg::JpegEncoder;
-    use image::{ImageEncoder, ImageFormat};
-
-    /// A colour field: slow gradients, a soft disc, and red stripes one texel wide (+60 on odd
-    /// columns), so a texel that is not the mean of the ones it covers (a skipped or shifted
-    /// one) is off by ~30 in red.
-    fn field(w: u32, h: u32) -> image::RgbImage {
-        image::RgbImage::from_fn(w, h, |x, y| {
-            let (u, v) = (x as f64 / w as f64, y as f64 / h as f64);
-            let d = ((u - 0.4).powi(2) + (v - 0.6).powi(2)).sqrt();
-            let disc = 1.0 / (1.0 + (40.0 * (d - 0.25)).exp());
-            image::Rgb([
-                (40.0 + 140.0 * u + 60.0 * (x % 2) as f64) as u8,
-                (30.0 + 150.0 * disc) as u8,
-                (200.0 - 120.0 * v) as u8,
-            ])
-        })
-    }
-
-    fn jpeg(img: &image::RgbImage) -> Vec<u8> {
-        let mut out = Vec::new();
-        JpegEncoder::new_with_quality(&mut out, 92)
-            .write_image(
-                img,
-                img.width(),
-                img.height(),
-                image::ExtendedColorType::Rgb8,
-            )
-            .unwrap();
-        out
-    }
-
-    /// The reduced decode has the size the rule asks (the smallest of 1/2, 1/4, 1/8 keeping a
-    /// side ≥ 512) and each texel is the mean of the full decode's texels it covers, to the
-    /// rounding of an 8-bit JPEG.
-    #[test]
-    fn reduced_jpeg_texels_are_the_means_of_the_full_ones() {
-        for (side, factor) in [(2048u32, 4u32), (1024, 2), (600, 1)] {
-            let bytes = jpeg(&field(side, side));
-            let small = jpeg_reduced(&bytes).expect("an RGB JPEG decodes");
-            assert_eq!(
-                (small.w, small.h),
-                (side / factor, side / factor),
-                "side {side}"
-            );
-            let full = image::load_from_memory(&bytes).unwrap().into_rgb8();
-            let (mut worst, mut sum, mut count) = (0.0f64, 0.0, 0usize);
-            for y in 0..small.h {
-                for x in 0..small.w {
-                    for c in 0..3 {
-                        let mut mean = 0.0;
-                        for dy in 0..factor {
-                            for dx in 0..factor {
-                                mean += full.get_pixel(x * factor + dx, y * factor + dy)[c as usize]
-                                    as f64;
-                            }
-                        }
-                        mean /= (factor * factor) as f64;
-                        let got = small.px[3 * (y * small.w + x) as usize + c] as f64;
-                        worst = worst.max((got - mean).abs());
-                        sum += (got - mean).abs();
-                        count += 1;
-                    }
-                }
-            }
-            let mean_err = sum / count as f64;
-            assert!(
-                mean_err < 4.0,
-                "side {side}: mean |Δ| {mean_err}, worst {worst}"
-            );
-            assert!(worst < 40.0, "side {side}: worst |Δ| {worst}");
-        }
-    }
-
-    /// A grey JPEG comes back as RGB with equal channels; a PNG and bytes that are not an image
-    /// are not handled here (the caller decodes them in full, or reads no colour).
-    #[test]
-    fn grey_jpeg_expands_and_other_bytes_fall_through() {
-        let grey = image::GrayImage::from_fn(1024, 1024, |x, _| image::Luma([(x / 4) as u8]));
-        let mut bytes = Vec::new();
-        JpegEncoder::new_with_quality(&mut bytes, 92)
-            .write_image(&grey, 1024, 1024, image::ExtendedColorType::L8)
-            .unwrap();
-        let img = jpeg_reduced(&bytes).expect("a grey JPEG decodes");
-        assert_eq!((img.w, img.h), (512, 512));
-        let texel = &img.px[3 * (10 * 512 + 300)..3 * (10 * 512 + 300) + 3];
-        assert_eq!(texel[0], texel[1]);
-        assert_eq!(texel[1], texel[2]);
-        // Texel 300 covers full columns 600–601, grey 150.
-        assert!((texel[0] as i32 - 150).abs() <= 2, "{texel:?}");
-
-        let mut png = Vec::new();
-        field(64, 64)
-            .write_to(&mut std::io::Cursor::new(&mut png), ImageFormat::Png)
-            .unwrap();
-        assert!(jpeg_reduced(&png).is_none());
-        let png = decoded(&Arc::new(png)).expect("a PNG decodes in full");
-        assert_eq!((png.w, png.h), (64, 64));
-
-        let mut broken = jpeg(&field(256, 256));
-        broken.truncate(40);
-        assert!(jpeg_reduced(&broken).is_none());
-        assert!(decoded(&Arc::new(broken)).is_none());
     }
 }

@@ -387,10 +387,7 @@ pub fn best_hypothesis(
     icp: &IcpOptions,
 ) -> Option<(Similarity, f64)> {
     use rayon::prelude::*;
-    // The hypotheses' short ICP on 250 guidance points (was 500, half the k-d queries): it only
-    // has to bring each start into its basin for the ranking below (on 700 probes), and the
-    // winner gets the full trimmed ICP (1,500 points, 60 iterations) after this.
-    let g_short = p.guidance.subsample(250);
+    let g_short = p.guidance.subsample(500);
     let probe_g = probes(p.guidance.len(), 700);
     let probe_o = probes(p.object.len(), 700);
     let short = IcpOptions {
@@ -413,11 +410,10 @@ pub fn best_hypothesis(
         }
     }
     // Axis turns around both bases; the SO(3) samples around the best one only (about its
-    // centre they already cover every orientation). 250 with colour (was 500: the nearest of
-    // N random rotations to the true one is then typically ~24° off, (6π/N)^(1/3), not ~19°).
+    // centre they already cover every orientation).
     let axis_turns = spins(&p.object_obb, 0, p.seed);
     let random_turns =
-        spins(&p.object_obb, if colour { 250 } else { 240 }, p.seed)[axis_turns.len()..].to_vec();
+        spins(&p.object_obb, if colour { 500 } else { 240 }, p.seed)[axis_turns.len()..].to_vec();
     let coarse_g = probes(p.guidance.len(), 200);
     let coarse_o = probes(p.object.len(), 200);
     let c = p.object_obb.center;
