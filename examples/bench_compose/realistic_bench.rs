@@ -413,6 +413,12 @@ pub fn run(args: &[String]) {
                                 (&truth_placed[0], &s.truth[n]),
                                 r.contact.as_ref(),
                             );
+                            if let Some(cr) = &r.colour_rest {
+                                eprintln!(
+                                    "  COLOURREST {id:<44} (pair {k:2}, seed {seed}) {}",
+                                    serde_json::to_string(cr).unwrap_or_default()
+                                );
+                            }
                             if let Some(sr) = &r.support {
                                 eprintln!(
                                     "  SUPPORTSTAGE {id:<44} (pair {k:2}, seed {seed}) {}",

@@ -20,6 +20,7 @@ use super::obb::Obb;
 use super::plane_icp::{plane_icp_offset, PlaneIcpOptions};
 use super::scale::rescaled;
 use crate::mesh::{P3, V3};
+use crate::pose::Similarity;
 
 /// Mean colours of a point set along an axis.
 #[derive(Clone, Debug)]
@@ -247,7 +248,8 @@ pub const ELONGATION_MIN: f64 = 2.0;
 /// than 3 %, the pose at that scale (the model's centre where the fit puts it along the axis)
 /// is refitted at fixed scale (point-to-plane, offset free) and offered as `colour_axis`. The
 /// guard keeps it only when it fits the guidance not worse: colour proposes, geometry judges.
-/// Returns the refit's rms when taken.
+/// Returns the offer (taken or not; a refused one may still be judged by the support,
+/// [`super::colour_rest`]).
 #[allow(clippy::too_many_arguments)]
 pub fn stage(
     object: &Cloud,
@@ -258,7 +260,7 @@ pub fn stage(
     bounds: (f64, f64),
     offset_max: f64,
     guard: &mut Guard,
-) -> Option<f64> {
+) -> Option<Offer> {
     let ob = Obb::of_points(&object.points);
     if ob.extents[0] < ELONGATION_MIN * ob.extents[1] || guidance.colours.len() != guidance.len() {
         return None;
@@ -295,7 +297,20 @@ pub fn stage(
         ..*pl
     };
     let (r, rms, _) = plane_icp_offset(object, matcher, g_icp, cand, &o);
-    guard.offer("colour_axis", r).then_some(rms)
+    Some(Offer {
+        pose: r,
+        rms,
+        taken: guard.offer("colour_axis", r),
+    })
+}
+
+/// The pose [`stage`] offered to the guard.
+#[derive(Clone, Copy, Debug)]
+pub struct Offer {
+    pub pose: Similarity,
+    /// The fixed-scale refit's rms (guidance units).
+    pub rms: f64,
+    pub taken: bool,
 }
 
 #[cfg(test)]

@@ -14,7 +14,8 @@
 //!    for an elongated object with colour, the size its colour along the long axis gives,
 //!    kept only when the guard finds it fits not worse ([`colour_axis`]);
 //! 5. an item's size from its resting contact ([`contact_scale`]; optionally first among
-//!    resting poses, [`support`], off by default);
+//!    resting poses, [`support`], off by default); the colour's refused size taken where the
+//!    item floats and that size rests ([`colour_rest`]);
 //! 6. collision-aware refinement of every further object against the fixed, already composed
 //!    objects' signed distance field ([`sdf`], [`refine`](mod@refine)); objects are added one
 //!    at a time, the composed scene becoming the new anchor.
@@ -27,6 +28,7 @@ pub mod bleed;
 pub mod cloud;
 pub mod colour;
 pub mod colour_axis;
+pub mod colour_rest;
 pub mod contact_scale;
 pub mod features;
 pub mod folder;
@@ -188,6 +190,9 @@ pub struct ObjectResult {
     /// The support sweep on an item placed after the anchor ([`support`]).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub support: Option<support::SupportReport>,
+    /// The colour's refused size judged by the support ([`colour_rest`]).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub colour_rest: Option<colour_rest::ColourRestReport>,
 }
 
 #[derive(Clone, Copy, Debug, Serialize)]
@@ -333,6 +338,7 @@ fn register(
     let (t, rms) = trimmed_icp(&object.points, &matcher, &g_icp, guard.pose(), &icp);
     guard.offer("trimmed_icp", t);
     let mut rms = rms;
+    let mut colour_refused = None;
     let probe_g = global::probes(guidance.len(), 700);
     let probe_o = global::probes(object.len(), 700);
     if !matches!(method, Method::IcpOnly | Method::RansacIcp) {
@@ -390,10 +396,10 @@ fn register(
         if use_colour {
             let bounds = (icp.scale_lo, icp.scale_hi);
             let (m, g) = (&matcher, &mut guard);
-            if let Some(r) =
-                colour_axis::stage(object, guidance, m, &g_icp, &pl, bounds, OFFSET_MAX, g)
-            {
-                rms = r;
+            match colour_axis::stage(object, guidance, m, &g_icp, &pl, bounds, OFFSET_MAX, g) {
+                Some(c) if c.taken => rms = c.rms,
+                Some(c) => colour_refused = Some(c.pose),
+                None => {}
             }
         }
     }
@@ -417,6 +423,7 @@ fn register(
         colour_used: use_colour,
         pose_stage: guard.stage().to_string(),
         stages: guard.log().to_vec(),
+        colour_refused,
     }
 }
 
@@ -431,6 +438,8 @@ struct Registered {
     colour_used: bool,
     pose_stage: String,
     stages: Vec<guard::StageFit>,
+    /// The colour's pose the guard refused ([`colour_axis::stage`]).
+    colour_refused: Option<Similarity>,
 }
 
 /// Compose the objects (steps 1–5). Errors only on unusable input (an empty mesh).
@@ -566,6 +575,22 @@ pub fn compose(inputs: &[ObjectInput], o: &ComposeOptions) -> Result<Composition
                 &mut stages,
             ));
         }
+        // The colour's refused size, where the item floats and that size rests ([`colour_rest`]).
+        let colour_rest = match (&field, reg.colour_refused, rank > 0 && o.method.refines()) {
+            (Some(f), Some(c), true) => Some(colour_rest::apply(
+                &inp.visual,
+                &object,
+                &object_tree,
+                spacing,
+                guidance,
+                f,
+                c,
+                &mut t,
+                &mut pose_stage,
+                &mut stages,
+            )),
+            _ => None,
+        };
         // The object's welded mesh, built once for the dense check and the anchor field.
         let geometry = std::cell::OnceCell::new();
         let geometry = || geometry.get_or_init(|| inp.visual.geometry());
@@ -679,6 +704,7 @@ pub fn compose(inputs: &[ObjectInput], o: &ComposeOptions) -> Result<Composition
             refinement,
             contact,
             support,
+            colour_rest,
         });
     }
     Ok(Composition {
