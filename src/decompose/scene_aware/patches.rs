@@ -223,10 +223,8 @@ struct Bound {
 /// inequality bounds `D`: a triangle keeps an upper bound `u` on `D` to its centre and a lower
 /// bound `l` on `D` to every other; when the centres move by `δ`, `u += δ(own)` and
 /// `l −= max δ(others)`. While `l² − u²` exceeds the slack (see [`SLACK`]) its computed
-/// distances would pick the same centre, strictly, so they are not computed; failing that, the
-/// distance to its own centre makes `u` exact and the test is made again (Hamerly's second
-/// test). Otherwise every distance is computed, in the same order with the same
-/// first-of-equals rule (the own centre's, computed once, read again). The assignment of every round is
+/// distances would pick the same centre, strictly, so they are not computed. Otherwise they
+/// are, in the same order with the same first-of-equals rule. The assignment of every round is
 /// thus the plain one, and so are the sums and the centres, bit for bit. The bounds are used
 /// only when every feature's `n nᵀ` entry lies in `[-1, 1]` and its position is finite (what
 /// the rounding estimate assumes; unit normals give it).
@@ -276,61 +274,20 @@ fn lloyd_counted(
             .enumerate()
             .with_min_len(MIN_LEN)
             .map(|(i, (b, x))| {
-                // `D²` is a computed distance less the triangle's own term, within the slack.
-                let own = || {
-                    let o = &x.orient;
-                    lambda2
-                        * (1.0
-                            - (o[0] * o[0]
-                                + o[3] * o[3]
-                                + o[5] * o[5]
-                                + 2.0 * (o[1] * o[1] + o[2] * o[2] + o[4] * o[4])))
-                };
-                let above = |d: f64, own: f64| {
-                    let e = d - own;
-                    let e = if e > 0.0 { e } else { 0.0 };
-                    (e * (1.0 + SLACK) + SLACK * lambda2).sqrt() * (1.0 + SLACK)
-                };
-                let below = |d: f64, own: f64| {
-                    let e = d - own;
-                    let e = if e > 0.0 { e } else { 0.0 };
-                    let e = e * (1.0 - SLACK) - SLACK * lambda2;
-                    if e > 0.0 {
-                        e.sqrt() * (1.0 - SLACK)
-                    } else {
-                        0.0
-                    }
-                };
-                let holds = |u: f64, l: f64| {
-                    l * l * (1.0 - SLACK) - u * u * (1.0 + SLACK) - 2.0 * SLACK * lambda2 > 0.0
-                };
-                // The distance to its own centre, when computed to tighten `u`.
-                let mut known = None;
                 if bounded && b.a != usize::MAX {
                     let u = (b.u + drift_now[b.a]) * (1.0 + SLACK);
                     let l = (b.l - others_now[b.a]) * (1.0 - SLACK);
                     let l = if l > 0.0 { l } else { 0.0 };
-                    if holds(u, l) {
+                    if l * l * (1.0 - SLACK) - u * u * (1.0 + SLACK) - 2.0 * SLACK * lambda2 > 0.0 {
                         (b.u, b.l) = (u, l);
                         return (false, 1);
                     }
-                    // Hamerly's second test: `u` exact (its own centre's distance), again.
-                    let da = dist2(x, &centres_now[b.a], lambda2);
-                    if !da.is_nan() {
-                        let u = above(da, own());
-                        if holds(u, l) {
-                            (b.u, b.l) = (u, l);
-                            return (false, 1);
-                        }
-                    }
-                    known = Some((b.a, da));
                 }
                 // The plain assignment: every distance, the first of the least.
                 let (mut bi, mut bd, mut second) = (0, f64::INFINITY, f64::INFINITY);
                 for (ci, c) in centres_now.iter().enumerate() {
-                    let d = match (first, known) {
-                        (Some(f), _) if ci == 0 => f[i],
-                        (_, Some((a, da))) if ci == a => da,
+                    let d = match first {
+                        Some(f) if ci == 0 => f[i],
                         _ => dist2(x, c, lambda2),
                     };
                     if d < bd {
@@ -341,12 +298,34 @@ fn lloyd_counted(
                         second = d;
                     }
                 }
+                // `D²` is the computed distance less the triangle's own term, within the slack.
+                let o = &x.orient;
+                let own = lambda2
+                    * (1.0
+                        - (o[0] * o[0]
+                            + o[3] * o[3]
+                            + o[5] * o[5]
+                            + 2.0 * (o[1] * o[1] + o[2] * o[2] + o[4] * o[4])));
+                let above = |d: f64| {
+                    let e = d - own;
+                    let e = if e > 0.0 { e } else { 0.0 };
+                    (e * (1.0 + SLACK) + SLACK * lambda2).sqrt() * (1.0 + SLACK)
+                };
+                let below = |d: f64| {
+                    let e = d - own;
+                    let e = if e > 0.0 { e } else { 0.0 };
+                    let e = e * (1.0 - SLACK) - SLACK * lambda2;
+                    if e > 0.0 {
+                        e.sqrt() * (1.0 - SLACK)
+                    } else {
+                        0.0
+                    }
+                };
                 // Not a number anywhere: no bound (the next round computes again).
                 let (u, l) = if !bounded || bd.is_nan() || second.is_nan() || k < 2 {
                     (f64::INFINITY, 0.0)
                 } else {
-                    let own = own();
-                    (above(bd, own), below(second, own))
+                    (above(bd), below(second))
                 };
                 let moved = b.a != bi;
                 *b = Bound { a: bi, u, l };
