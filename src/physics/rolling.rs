@@ -166,8 +166,9 @@ impl Rolling {
                 }
             }
         }
-        // The next step's torque: the step's total hold, warm-starting the next step (bounded
-        // by this step's μ_r·N).
+        // The next step's torque: the step's total hold, warm-starting the next step. It is
+        // clamped to this step's μ_r·J only when the pair still rolled after the step (a pair
+        // held still keeps last step's torque, which was within last step's bound).
         let torques: BTreeMap<(usize, usize), Vector> =
             held.into_iter().map(|(key, h)| (key, h / dt)).collect();
         for &h in handles {
