@@ -2,21 +2,27 @@
 //!
 //! Entry point: [`Rolling::update`], called by `Sim::step` after every Rapier step.
 //!
-//! Between two bodies in contact (or a body and the floor) it keeps one torque, applied to the
-//! first body and its opposite to the second, that opposes their relative rolling: the part of
-//! `ω₁ − ω₂` perpendicular to the contact normal. Its size is at most `μ_r·N`, `N` the normal
-//! force of the pair's contacts at the last step and `μ_r` a length, MuJoCo's rolling friction
-//! (a geom's third `friction` value, active with `condim="6"`, the torque bounded by `μ_r` times
-//! the normal force), which the MJCF export writes with the same value. Below that bound the
-//! torque holds the pair from rolling (a ball on an incline with `tan θ ≤ μ_r / r` stays), at it
-//! the pair rolls and decelerates. The torque is kept from step to step and corrected by what
-//! still rolled, the way the solver warm-starts its impulses: after a step in which the pair
-//! rolled at `w`, the torque changes by the one that would stop `w` in one step about the
-//! centres of mass (shared among the pairs of the busier body); the contacts' own friction adds
-//! inertia to that rolling, so the correction converges from below without overshoot.
+//! Between two bodies in contact (or a body and the floor) it bounds the angular impulse that
+//! opposes their relative rolling (the part of `ω₁ − ω₂` perpendicular to the contact normal)
+//! by `μ_r·J`, `J` the normal impulse of the pair's contacts in the step and `μ_r` a length,
+//! MuJoCo's rolling friction (a geom's third `friction` value, active with `condim="6"`), which
+//! the MJCF export writes with the same value. A ball on an incline with `tan θ ≤ μ_r / r`
+//! stays, exactly; above it rolls and decelerates by `μ_r g cos θ / r` over its inertia.
+//!
+//! It acts twice per step, as a solver would (a warm start, then an iteration):
+//! - the pair's hold of the last step is applied again during the next as a torque (through
+//!   Rapier's user torques), so a body held last step is held through this one without moving;
+//! - after the step, whatever the pair still rolls is cancelled at once, before the next
+//!   position update, by an angular impulse about the contact point (the body turning there
+//!   without slipping, so the contact's friction does not hand the rolling back) that keeps
+//!   the step's total within `μ_r·J`; Gauss–Seidel over the pairs, a body's pairs sharing it.
+//!
+//! The torque alone, corrected one step late (session 17's), crept 2–30 µm in 2 s on the
+//! incline below θ_c where MuJoCo holds still (docs/agreement.md "Fifteenth stop").
 //! Spin about the normal is not included (Rapier's contacts carry a twist friction already).
 
 use super::*;
+use nalgebra::{Matrix3, Vector3};
 use rapier3d_f64::prelude::RigidBodyHandle;
 use std::collections::{BTreeMap, HashMap};
 
@@ -38,6 +44,8 @@ struct PairContact {
     impulse: Real,
     /// Impulse-weighted sum of the normals, from the pair's first body towards its second.
     normal: Vector,
+    /// Impulse-weighted sum of the contact points (world, midway between the two surfaces).
+    point: Vector,
 }
 
 impl Rolling {
@@ -70,13 +78,23 @@ impl Rolling {
                 // it (parry's manifold has up to one more) keeps the impulse it inherited from
                 // the point it was matched to, stale; on the 0.01° incline those made `N`
                 // 1.41–1.54× the weight (docs/agreement.md "Fourteenth stop").
-                let impulse: Real = m
-                    .data
-                    .solver_contacts
-                    .iter()
-                    .filter_map(|c| m.points.get(c.contact_indices()[0] as usize))
-                    .map(|p| p.data.impulse)
-                    .sum();
+                let (Some(c1), Some(c2)) = (
+                    world.colliders.get(cp.collider1),
+                    world.colliders.get(cp.collider2),
+                ) else {
+                    continue;
+                };
+                let (pos1, pos2) = (*c1.position(), *c2.position());
+                let mut impulse = 0.0;
+                let mut point = Vector::ZERO;
+                for c in &m.data.solver_contacts {
+                    if let Some(p) = m.points.get(c.contact_indices()[0] as usize) {
+                        impulse += p.data.impulse;
+                        let at = 0.5
+                            * (pos1.transform_point(p.local_p1) + pos2.transform_point(p.local_p2));
+                        point += at * p.data.impulse;
+                    }
+                }
                 if impulse <= 0.0 {
                     continue;
                 }
@@ -85,12 +103,8 @@ impl Rolling {
                 let e = pairs.entry(key).or_default();
                 e.impulse += impulse;
                 e.normal += m.data.normal * (sign * impulse);
+                e.point += point;
             }
-        }
-        let mut count = vec![0usize; n + 1];
-        for &(a, b) in pairs.keys() {
-            count[a] += 1;
-            count[b] += 1;
         }
         let awake: Vec<bool> = (0..=n)
             .map(|k| {
@@ -101,47 +115,62 @@ impl Rolling {
             })
             .collect();
         let moving = |k: usize| awake[k];
-        let mut torques = BTreeMap::new();
-        for (&(a, b), c) in &pairs {
-            if !(moving(a) || moving(b)) {
-                continue;
-            }
-            let Some(nrm) = unit(c.normal) else {
-                continue;
-            };
-            let angvel = |k: usize| {
-                if k < n {
-                    world.bodies[handles[k]].angvel()
-                } else {
-                    Vector::ZERO
+        // The pairs that act: a body of the pair moving, a normal and a point.
+        let acting: Vec<((usize, usize), Vector, Vector, Real)> = pairs
+            .iter()
+            .filter(|(&(a, b), _)| moving(a) || moving(b))
+            .filter_map(|(&key, c)| Some((key, unit(c.normal)?, c.point / c.impulse, c.impulse)))
+            .collect();
+        // The hold, within the step: the rolling that the step left is cancelled now, before
+        // the next position update, by an angular impulse about the contact point that keeps
+        // each pair's total for the step (the kept torque's share included) within μ_r·J, J
+        // the step's normal impulse. Gauss–Seidel over the pairs (a body's pairs share it).
+        let mut held: BTreeMap<(usize, usize), Vector> = acting
+            .iter()
+            .map(|&(key, nrm, _, _)| {
+                let t = self.torques.get(&key).copied().unwrap_or(Vector::ZERO);
+                (key, (t - nrm * nrm.dot(t)) * dt)
+            })
+            .collect();
+        for _ in 0..HOLD_SWEEPS {
+            for &((a, b), nrm, at, impulse) in &acting {
+                let w = angvel(world, handles, n, a) - angvel(world, handles, n, b);
+                let roll = w - nrm * nrm.dot(w);
+                let Some(d) = unit(roll) else {
+                    continue;
+                };
+                let pa = moving(a).then(|| Pivot::new(&world.bodies[handles[a]], at));
+                let pb = moving(b).then(|| Pivot::new(&world.bodies[handles[b]], at));
+                let k: Real = [&pa, &pb]
+                    .iter()
+                    .filter_map(|p| p.as_ref().map(|p| d.dot(p.turn(d))))
+                    .sum();
+                if k <= 0.0 {
+                    continue;
                 }
-            };
-            let inv_inertia = |k: usize, d: Vector| -> Real {
-                if moving(k) {
-                    let mp = world.bodies[handles[k]].mass_properties();
-                    d.dot(mp.effective_world_inv_inertia * d)
-                } else {
-                    0.0
+                let acc = held.entry((a, b)).or_insert(Vector::ZERO);
+                let mut next = *acc - roll / k;
+                next -= nrm * nrm.dot(next);
+                let limit = self.mu * impulse;
+                let size = next.length();
+                if size > limit {
+                    next *= limit / size;
                 }
-            };
-            let w = angvel(a) - angvel(b);
-            let roll = w - nrm * nrm.dot(w);
-            let mut t = self.torques.get(&(a, b)).copied().unwrap_or(Vector::ZERO);
-            t -= nrm * nrm.dot(t);
-            if let Some(d) = unit(roll) {
-                let k = inv_inertia(a, d) + inv_inertia(b, d);
-                if k > 0.0 {
-                    let share = count[a].max(count[b]).max(1) as Real;
-                    t -= roll / (k * dt * share);
+                let applied = next - *acc;
+                *acc = next;
+                if let Some(p) = pa {
+                    p.apply(&mut world.bodies[handles[a]], applied);
+                }
+                if let Some(p) = pb {
+                    p.apply(&mut world.bodies[handles[b]], -applied);
                 }
             }
-            let limit = self.mu * c.impulse / dt;
-            let size = t.length();
-            if size > limit {
-                t *= limit / size;
-            }
-            torques.insert((a, b), t);
         }
+        // The next step's torque: the step's total hold, warm-starting the next step. It is
+        // clamped to this step's μ_r·J only when the pair still rolled after the step (a pair
+        // held still keeps last step's torque, which was within last step's bound).
+        let torques: BTreeMap<(usize, usize), Vector> =
+            held.into_iter().map(|(key, h)| (key, h / dt)).collect();
         for &h in handles {
             let rb = &mut world.bodies[h];
             if rb.is_dynamic() {
@@ -157,6 +186,60 @@ impl Rolling {
             }
         }
         self.torques = torques;
+    }
+}
+
+/// Gauss–Seidel sweeps of the hold over a step's pairs.
+const HOLD_SWEEPS: usize = 4;
+
+/// Body `k`'s angular velocity (the floor's is zero).
+fn angvel(world: &PhysicsWorld, handles: &[RigidBodyHandle], n: usize, k: usize) -> Vector {
+    if k < n {
+        world.bodies[handles[k]].angvel()
+    } else {
+        Vector::ZERO
+    }
+}
+
+/// A body turning about a contact point without slipping there: an angular impulse `h` turns
+/// it by `I_P⁻¹ h` (`I_P` its inertia about the point) and moves its centre of mass with the
+/// turn, the way rolling friction stops a ball whose contact friction keeps it from sliding.
+struct Pivot {
+    /// Inverse inertia about the point (world).
+    inv: Matrix3<Real>,
+    /// Centre of mass from the point.
+    arm: Vector3<Real>,
+}
+
+impl Pivot {
+    fn new(rb: &rapier3d_f64::prelude::RigidBody, at: Vector) -> Self {
+        let v = |x: Vector| Vector3::new(x.x, x.y, x.z);
+        let inv_com = rb.mass_properties().effective_world_inv_inertia;
+        let cols = [Vector::X, Vector::Y, Vector::Z].map(|e| v(inv_com * e));
+        let inv_com = Matrix3::from_columns(&cols);
+        let arm = v(rb.center_of_mass() - at);
+        let shift = (Matrix3::identity() * arm.norm_squared() - arm * arm.transpose()) * rb.mass();
+        let inv = inv_com
+            .try_inverse()
+            .and_then(|i| (i + shift).try_inverse())
+            .unwrap_or(inv_com);
+        Pivot { inv, arm }
+    }
+
+    /// The turn an angular impulse `h` gives.
+    fn turn(&self, h: Vector) -> Vector {
+        let t = self.inv * Vector3::new(h.x, h.y, h.z);
+        Vector::new(t.x, t.y, t.z)
+    }
+
+    /// Gives the body the angular impulse `h` about the point.
+    fn apply(&self, rb: &mut rapier3d_f64::prelude::RigidBody, h: Vector) {
+        let dw = self.turn(h);
+        let arm = Vector::new(self.arm.x, self.arm.y, self.arm.z);
+        let w = rb.angvel() + dw;
+        let v = rb.linvel() + dw.cross(arm);
+        rb.set_angvel(w, false);
+        rb.set_linvel(v, false);
     }
 }
 
