@@ -25,9 +25,10 @@
 //! `compose` calls it).
 
 use super::cloud::Cloud;
-use super::contact_scale::{visible, GapProbe, DENSE};
-use super::guard::{Guard, StageFit};
+use super::contact_scale::{visible, GapProbe};
+use super::guard::Guard;
 use super::kdtree::KdTree;
+use super::placed::{Item, Placed};
 use super::sdf::AnchorField;
 use crate::mesh::P3;
 use crate::pose::Similarity;
@@ -107,48 +108,29 @@ pub fn judge<'a>(
 }
 
 /// [`judge`] as `compose` calls it on an item placed after the anchor whose colour candidate
-/// the registration refused: the guard's pose, stage and log folded back into `t`,
-/// `pose_stage` and `stages`.
-#[allow(clippy::too_many_arguments)]
-pub(super) fn apply(
-    visual: &crate::mesh::VisualMesh,
-    object: &Cloud,
-    tree: &KdTree,
-    spacing: f64,
-    guidance: &Cloud,
-    field: &AnchorField,
-    candidate: Similarity,
-    t: &mut Similarity,
-    pose_stage: &mut String,
-    stages: &mut Vec<StageFit>,
-) -> ColourRestReport {
-    let offsets = (super::plane_icp::scale_offset_correlation(object)
-        < super::OFFSET_CORRELATION_MAX)
-        .then_some(super::OFFSET_MAX);
-    let probe = guidance.subsample(1000).points;
-    let dense = Cloud::sample(visual, DENSE, 0x6a70).points;
-    let gaps = GapProbe::new(object.subsample(1000).points, &dense);
+/// the registration refused: the guard's pose, stage and log folded back into `placed`.
+pub(super) fn apply(item: &Item, candidate: Similarity, placed: &mut Placed) -> ColourRestReport {
+    let gaps = GapProbe::new(item.object.subsample(1000).points, &item.dense());
     let (g, report) = judge(
-        object,
-        tree,
-        spacing,
-        guidance,
+        item.object,
+        item.tree,
+        item.spacing,
+        item.guidance,
         &gaps,
-        probe,
-        (*t, pose_stage.as_str()),
+        item.guidance.subsample(1000).points,
+        (placed.pose, placed.stage.as_str()),
         candidate,
-        field,
-        offsets,
+        item.field,
+        item.offset_max(),
     );
-    *t = g.pose();
-    *pose_stage = g.stage().to_string();
-    stages.extend(g.log().iter().skip(1).cloned());
+    placed.take(&g);
     report
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::compose::contact_scale::DENSE;
     use crate::compose::guard::spacing;
     use crate::mesh::{Mesh, V3};
 

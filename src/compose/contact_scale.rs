@@ -46,6 +46,7 @@ use super::guard::Guard;
 use super::icp::Matcher;
 use super::kdtree::KdTree;
 use super::obb::Obb;
+use super::placed::{Item, Placed};
 use super::plane_icp::{plane_icp, scale_offset_correlation, PlaneIcpOptions};
 use super::scale::rescaled;
 use super::sdf::AnchorField;
@@ -474,31 +475,23 @@ pub fn run<'a>(
 }
 
 /// The stage as the pipeline calls it on an item placed after the anchor: [`run`] from the
-/// registration's pose `t` and stage, with the normal offsets measured where the shape allows
-/// them, and the guard's pose, stage and log folded back into `t`, `pose_stage` and `stages`.
-#[allow(clippy::too_many_arguments)]
-pub(super) fn apply(
-    visual: &crate::mesh::VisualMesh,
-    object: &Cloud,
-    tree: &KdTree,
-    spacing: f64,
-    guidance: &Cloud,
-    field: &AnchorField,
-    o: &ContactOptions,
-    t: &mut Similarity,
-    pose_stage: &mut String,
-    stages: &mut Vec<super::guard::StageFit>,
-) -> ContactReport {
-    let offsets = (scale_offset_correlation(object) < super::OFFSET_CORRELATION_MAX)
-        .then_some(super::OFFSET_MAX);
-    let probe = guidance.subsample(1000).points;
-    let dense = Cloud::sample(visual, DENSE, 0x6a70).points;
+/// item's pose and stage, with the normal offsets measured where the shape allows them, and
+/// the guard's pose, stage and log folded back into `placed`.
+pub(super) fn apply(item: &Item, o: &ContactOptions, placed: &mut Placed) -> ContactReport {
     let (g, report) = run(
-        object, tree, spacing, guidance, &dense, probe, *t, pose_stage, field, offsets, o,
+        item.object,
+        item.tree,
+        item.spacing,
+        item.guidance,
+        &item.dense(),
+        item.guidance.subsample(1000).points,
+        placed.pose,
+        &placed.stage,
+        item.field,
+        item.offset_max(),
+        o,
     );
-    *t = g.pose();
-    *pose_stage = g.stage().to_string();
-    stages.extend(g.log().iter().skip(1).cloned());
+    placed.take(&g);
     report
 }
 

@@ -38,6 +38,7 @@ pub mod icp;
 pub mod kdtree;
 pub mod obb;
 pub mod occlusion;
+pub mod placed;
 pub mod plane_icp;
 pub mod realistic;
 pub mod reconstruction;
@@ -74,6 +75,7 @@ const OFFSET_CORRELATION_MAX: f64 = 0.85;
 use kdtree::KdTree;
 use obb::Obb;
 use occlusion::Occlusion;
+use placed::{Item, Placed};
 use refine::{refine, RefineOptions, Refined, Target};
 use sdf::AnchorField;
 use serde::Serialize;
@@ -538,59 +540,41 @@ pub fn compose(inputs: &[ObjectInput], o: &ComposeOptions) -> Result<Composition
             o.method,
             seed,
         );
-        let (mut t, mut method, colour_used) = (reg.transform, reg.method.clone(), reg.colour_used);
-        let mut pose_stage = reg.pose_stage.clone();
-        let mut stages = reg.stages.clone();
+        let (mut method, colour_used) = (reg.method.clone(), reg.colour_used);
+        let mut placed = Placed {
+            pose: reg.transform,
+            stage: reg.pose_stage.clone(),
+            log: reg.stages.clone(),
+        };
         let mut refinement = None;
         let mut contact = None;
-        // An item that does not rest on the placed objects: its size among resting poses.
-        let support = match (&field, &o.support, rank > 0 && o.method.refines()) {
-            (Some(f), Some(so), true) => Some(support::apply(
-                &inp.visual,
-                &object,
-                &object_tree,
+        let mut support = None;
+        let mut colour_rest = None;
+        if let (Some(field), true) = (&field, rank > 0 && o.method.refines()) {
+            let item = Item {
+                visual: &inp.visual,
+                object: &object,
+                tree: &object_tree,
                 spacing,
                 guidance,
-                f,
-                so,
-                &mut t,
-                &mut pose_stage,
-                &mut stages,
-            )),
-            _ => None,
-        };
-        // An item's size from its resting contact with the placed objects, where the guidance
-        // does not show it ([`contact_scale`]); the guard decides, within the guidance's noise.
-        if let (Some(f), Some(c), true) = (&field, &o.contact, rank > 0 && o.method.refines()) {
-            contact = Some(contact_scale::apply(
-                &inp.visual,
-                &object,
-                &object_tree,
-                spacing,
-                guidance,
-                f,
-                c,
-                &mut t,
-                &mut pose_stage,
-                &mut stages,
-            ));
+                field,
+            };
+            // An item that does not rest on the placed objects: its size among resting poses.
+            if let Some(so) = &o.support {
+                support = Some(support::apply(&item, so, &mut placed));
+            }
+            // An item's size from its resting contact with the placed objects, where the
+            // guidance does not show it ([`contact_scale`]); the guard decides, within the
+            // guidance's noise.
+            if let Some(c) = &o.contact {
+                contact = Some(contact_scale::apply(&item, c, &mut placed));
+            }
+            // The colour's refused size, where the item floats and that size rests
+            // ([`colour_rest`]).
+            if let Some(c) = reg.colour_refused {
+                colour_rest = Some(colour_rest::apply(&item, c, &mut placed));
+            }
         }
-        // The colour's refused size, where the item floats and that size rests ([`colour_rest`]).
-        let colour_rest = match (&field, reg.colour_refused, rank > 0 && o.method.refines()) {
-            (Some(f), Some(c), true) => Some(colour_rest::apply(
-                &inp.visual,
-                &object,
-                &object_tree,
-                spacing,
-                guidance,
-                f,
-                c,
-                &mut t,
-                &mut pose_stage,
-                &mut stages,
-            )),
-            _ => None,
-        };
         // The object's welded mesh, built once for the dense check and the anchor field.
         let geometry = std::cell::OnceCell::new();
         let geometry = || geometry.get_or_init(|| inp.visual.geometry());
@@ -616,7 +600,7 @@ pub fn compose(inputs: &[ObjectInput], o: &ComposeOptions) -> Result<Composition
                     matcher: &matcher,
                     keep: 0.8,
                 };
-                let start = t;
+                let start = placed.pose;
                 let mut r = refine(&sub.points, &target, start, f, unit, &o.refine);
                 // Dense check: 700 samples miss thin parts between them (a shoe's edge stayed
                 // 1.5 mm inside the tray). The object's vertices within the clearance band join
@@ -653,7 +637,7 @@ pub fn compose(inputs: &[ObjectInput], o: &ComposeOptions) -> Result<Composition
                     spacing,
                     guidance.subsample(1000).points,
                     start,
-                    &pose_stage,
+                    &placed.stage,
                 );
                 guard.with_allowance(r.penetration_before + 2.0 * o.refine.epsilon * unit);
                 if !guard.offer("collision_refine", r.transform) {
@@ -670,30 +654,28 @@ pub fn compose(inputs: &[ObjectInput], o: &ComposeOptions) -> Result<Composition
                         r = r2;
                     }
                 }
-                t = guard.pose();
-                pose_stage = guard.stage().to_string();
-                stages.extend(guard.log().iter().skip(1).cloned());
+                placed.take(&guard);
                 method.push_str("+collision_refine");
                 refinement = Some(RefineReport::from(&r));
             }
         }
         if o.method.refines() && rank + 1 < order.len() {
-            let placed: Mesh = geometry().transformed(&t.matrix());
+            let mesh: Mesh = geometry().transformed(&placed.pose.matrix());
             let fld = field.get_or_insert_with(|| AnchorField::new(&[], 32));
-            fld.push(&placed, 32);
+            fld.push(&mesh, 32);
         }
         if rank + 1 < order.len() {
             placed_samples[i] = Some(
                 Cloud::sample(&inp.visual, 800, seed ^ 2)
-                    .transformed(&t.matrix())
+                    .transformed(&placed.pose.matrix())
                     .points,
             );
         }
         results.push(ObjectResult {
             name: inp.name.clone(),
-            transform: t,
-            pose_stage,
-            stages,
+            transform: placed.pose,
+            pose_stage: placed.stage,
+            stages: placed.log,
             method,
             silhouette_area: areas[i],
             initial_scale: reg.scale0,

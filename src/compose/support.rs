@@ -26,14 +26,14 @@
 //! [`SupportOptions`], [`SupportReport`].
 
 use super::cloud::Cloud;
-use super::contact_scale::{visible, GapProbe, DENSE};
-use super::guard::{Guard, StageFit};
+use super::contact_scale::{visible, GapProbe};
+use super::guard::Guard;
 use super::icp::Matcher;
-use super::kdtree::KdTree;
-use super::plane_icp::{plane_icp_offset, scale_offset_correlation, PlaneIcpOptions};
+use super::placed::{Item, Placed};
+use super::plane_icp::{plane_icp_offset, PlaneIcpOptions};
 use super::scale::rescaled;
 use super::sdf::AnchorField;
-use crate::mesh::{VisualMesh, P3, V3};
+use crate::mesh::{P3, V3};
 use crate::pose::Similarity;
 use serde::Serialize;
 
@@ -158,26 +158,19 @@ pub fn resting_fit(
 /// (fits with the normal offset taken out where the shape allows it, the cap fixed at the
 /// registered pose's), and fold the guard's pose, stage and log back. `bounds`: the scale's
 /// global bounds.
-#[allow(clippy::too_many_arguments)]
-pub(super) fn apply(
-    visual: &VisualMesh,
-    object: &Cloud,
-    tree: &KdTree,
-    spacing: f64,
-    guidance: &Cloud,
-    field: &AnchorField,
-    o: &SupportOptions,
-    t: &mut Similarity,
-    pose_stage: &mut String,
-    stages: &mut Vec<StageFit>,
-) -> SupportReport {
+pub(super) fn apply(item: &Item, o: &SupportOptions, placed: &mut Placed) -> SupportReport {
     use rayon::prelude::*;
-    let start = *t;
+    let Item {
+        object,
+        tree,
+        spacing,
+        guidance,
+        field,
+        ..
+    } = *item;
+    let start = placed.pose;
     let diag = object.diagonal();
-    let probe = GapProbe::new(
-        object.subsample(1000).points,
-        &Cloud::sample(visual, DENSE, 0x6a70).points,
-    );
+    let probe = GapProbe::new(object.subsample(1000).points, &item.dense());
     let g0 = probe.gap(&start, field);
     let mut guard = Guard::new(
         object,
@@ -185,11 +178,11 @@ pub(super) fn apply(
         spacing,
         guidance.subsample(1000).points,
         start,
-        pose_stage,
+        &placed.stage,
     );
-    let offsets = scale_offset_correlation(object) < super::OFFSET_CORRELATION_MAX;
-    if offsets {
-        guard.measure_offsets(super::OFFSET_MAX);
+    let offsets = item.offset_max();
+    if let Some(f) = offsets {
+        guard.measure_offsets(f);
     }
     guard.fix_cap();
     let g_icp = guidance.subsample(o.points);
@@ -218,7 +211,7 @@ pub(super) fn apply(
     }
     let lows = object.subsample(o.gap_samples).points;
     let matcher = Matcher::Geometry(tree);
-    let offset_max = if offsets { super::OFFSET_MAX } else { 0.0 };
+    let offset_max = offsets.unwrap_or(0.0);
     let fitted = |lk: f64| -> Option<(f64, Similarity, f64)> {
         let s = start.scale * lk.exp();
         let r = resting_fit(
@@ -269,9 +262,7 @@ pub(super) fn apply(
     report.fit_after = Some(fit);
     guard.with_allowance(noise);
     report.taken = guard.offer("support_sweep", pose);
-    *t = guard.pose();
-    *pose_stage = guard.stage().to_string();
-    stages.extend(guard.log().iter().skip(1).cloned());
+    placed.take(&guard);
     report
 }
 
@@ -279,6 +270,7 @@ pub(super) fn apply(
 mod tests {
     use super::*;
     use crate::compose::guard::spacing;
+    use crate::compose::kdtree::KdTree;
     use crate::mesh::Mesh;
     use nalgebra::UnitQuaternion;
 
@@ -321,10 +313,22 @@ mod tests {
         let start = rescaled(&truth, 1.2, &P3::new(0.0, 0.15, 0.0));
         let sp = spacing(&vis, 5000);
         let o = SupportOptions::default();
-        let (mut t, mut stage, mut log) = (start, "start".to_string(), Vec::new());
-        let r = apply(
-            &vis, &obj, &tree, sp, &g, &field, &o, &mut t, &mut stage, &mut log,
-        );
+        let item = Item {
+            visual: &vis,
+            object: &obj,
+            tree: &tree,
+            spacing: sp,
+            guidance: &g,
+            field: &field,
+        };
+        let placed = |pose| Placed {
+            pose,
+            stage: "start".to_string(),
+            log: Vec::new(),
+        };
+        let mut p = placed(start);
+        let r = apply(&item, &o, &mut p);
+        let (t, stage) = (p.pose, p.stage);
         assert!(
             (r.gap_before - 0.09 / (1.2 * obj.diagonal())).abs() < 0.01,
             "{r:?}"
@@ -342,21 +346,10 @@ mod tests {
         assert!(bottom.abs() < 2e-3, "bottom at {bottom}");
         assert!((t.translation - truth.translation).norm() < 0.02, "{t:?}");
         // At the true pose it already rests: skipped, the pose kept.
-        let (mut t2, mut stage2, mut log2) = (truth, "start".to_string(), Vec::new());
-        let r2 = apply(
-            &vis,
-            &obj,
-            &tree,
-            sp,
-            &g,
-            &field,
-            &o,
-            &mut t2,
-            &mut stage2,
-            &mut log2,
-        );
+        let mut p2 = placed(truth);
+        let r2 = apply(&item, &o, &mut p2);
         assert_eq!(r2.skipped, Some("resting"));
-        assert_eq!(t2.scale, truth.scale);
-        assert_eq!(stage2, "start");
+        assert_eq!(p2.pose.scale, truth.scale);
+        assert_eq!(p2.stage, "start");
     }
 }
