@@ -24,8 +24,7 @@
 mod seeds;
 use interact3d::agreement::nudge::{self, Spread};
 use interact3d::agreement::{
-    judge::{judge_nudged, judge_with},
-    run_scene_with, summary, Catalog, Generated, Judged, Summary,
+    judge::Judge, run_scene_with, summary, Catalog, Generated, Judged, Summary,
 };
 use interact3d::physics::SettleOptions;
 use rayon::prelude::*;
@@ -241,7 +240,11 @@ fn physx_nudged(
     if todo.is_empty() {
         return Vec::new();
     }
-    let res = judge_nudged("PhysX", python, script, &todo, settle_s).unwrap_or_else(|e| {
+    let judge = Judge {
+        settle_s,
+        ..Judge::new("PhysX", python, script)
+    };
+    let res = judge.nudged(&todo).unwrap_or_else(|e| {
         eprintln!("PhysX nudges: {e}");
         Vec::new()
     });
@@ -405,7 +408,11 @@ fn judged_by(
     lines: &mut std::fs::File,
     settle_s: f64,
 ) -> Vec<Judged> {
-    let judged = judge_with(engine, python, script, done, settle_s).unwrap_or_else(|e| {
+    let judge = Judge {
+        settle_s,
+        ..Judge::new(engine, python, script)
+    };
+    let judged = judge.run(done).unwrap_or_else(|e| {
         eprintln!("{e}");
         std::process::exit(1)
     });

@@ -14,7 +14,7 @@
 //! not share. Not every such stack agrees: of this catalog's six loaded scenes we pass in
 //! 0..40, MuJoCo fails seed 30 and moves the box of seeds 5 and 32 past 1 mm (docs/agreement.md).
 //!
-//! A third case runs PhysX's own verdict from the nudged composed poses (`judge_nudged`, what
+//! A third case runs PhysX's own verdict from the nudged composed poses (`Judge::nudged`, what
 //! `agreement --physx --nudge` counts) on that stack: every nudged start passes, as in ours.
 
 mod common;
@@ -168,14 +168,14 @@ fn heavy_item_on_light_one_agrees_only_with_the_load_rule() {
     }
 }
 
-/// PhysX's own verdict from nudged composed poses (`judge_nudged`, the `--nudge` count of the
+/// PhysX's own verdict from nudged composed poses (`Judge::nudged`, the `--nudge` count of the
 /// generator): the loaded stack above (a 4.1 kg box lying flat on 47 g scissors) nudged by
 /// 0.5° or 0.5 mm stays a pass in PhysX from every start, as in ours: one start a nudge of
 /// ours (`validate::nudge::nudged_poses`, 8 a free body), and the unnudged answer is the
 /// plain judge's to the bit.
 #[test]
 fn physx_keeps_a_flat_load_from_every_nudged_start() {
-    use interact3d::agreement::judge::{judge_nudged, judge_with};
+    use interact3d::agreement::judge::Judge;
     let tmp = tempfile::tempdir().unwrap();
     let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/datasets/objects");
     let catalog = Catalog::load(&dir, Some(&LOADED), Some(tmp.path().join("cache"))).unwrap();
@@ -188,9 +188,12 @@ fn physx_keeps_a_flat_load_from_every_nudged_start() {
     let python = common::python();
     let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/python/agreement_physx.py");
     let scenes = [(g, ours, out)];
-    let plain = &judge_with("PhysX", &python, &script, &scenes, settle.settle_max_time).unwrap()[0];
-    let nudged =
-        &judge_nudged("PhysX", &python, &script, &scenes, settle.settle_max_time).unwrap()[0];
+    let judge = Judge {
+        settle_s: settle.settle_max_time,
+        ..Judge::new("PhysX", &python, &script)
+    };
+    let plain = &judge.run(&scenes).unwrap()[0];
+    let nudged = &judge.nudged(&scenes).unwrap()[0];
     let v = nudged.mujoco.nudged.clone().expect("nudged verdicts");
     eprintln!("ours nudged {our_nudged:?}; PhysX nudged {v:?}");
     assert!(plain.mujoco.nudged.is_none());

@@ -11,8 +11,8 @@
 //! where both come to rest (seeds 83 and 93 of 0..300; docs/agreement.md). The engine's rest answer: from the exported
 //! (settled) pose, every body stays within 1 mm and 1° for 2 s.
 //!
-//! Entry points: [`judge`], [`judge_with`], [`judge_nudged`] (the engine's verdict from our
-//! nudged composed poses as well, PhysX only), [`summary`].
+//! Entry points: [`judge`], [`Judge`] (`run` with another settle time, `nudged`: the engine's
+//! verdict from our nudged composed poses as well, PhysX only), [`summary`].
 
 use super::{Generated, Ours};
 use crate::error::{Error, Result};
@@ -59,7 +59,7 @@ pub struct MjScene {
     pub bodies: BTreeMap<String, MjBody>,
     pub seconds: f64,
     /// The engine's own verdict from the composed pose nudged as our validator nudges it
-    /// (`validate::nudge::nudged_poses`' starts and order), when asked ([`judge_nudged`]).
+    /// (`validate::nudge::nudged_poses`' starts and order), when asked ([`Judge::nudged`]).
     #[serde(default)]
     pub nudged: Option<Vec<bool>>,
 }
@@ -86,51 +86,60 @@ pub struct Judged {
 }
 
 /// Run a judge script (`engine` names it in causes) on exported scenes (`scenes[i].2` holds
-/// the export of `scenes[i].0`).
+/// the export of `scenes[i].0`), the engine's settle part as long as ours by default.
 pub fn judge(
     engine: &str,
     python: &str,
     script: &Path,
     scenes: &[(Generated, Ours, PathBuf)],
 ) -> Result<Vec<Judged>> {
-    let settle_s = crate::physics::SettleOptions::default().settle_max_time;
-    judge_with(engine, python, script, scenes, settle_s)
+    Judge::new(engine, python, script).run(scenes)
 }
 
-/// [`judge`] with the engine's settle part lasting `settle_s` seconds (our settle cap, when
-/// experiments change it).
-pub fn judge_with(
-    engine: &str,
-    python: &str,
-    script: &Path,
-    scenes: &[(Generated, Ours, PathBuf)],
-    settle_s: f64,
-) -> Result<Vec<Judged>> {
-    run_judge(engine, python, script, scenes, settle_s, false)
+/// A judge script and how it runs: `engine` names it in causes, `python` runs `script`, and
+/// the engine's settle part lasts `settle_s` seconds (our settle cap, when experiments change
+/// it).
+#[derive(Clone, Copy, Debug)]
+pub struct Judge<'a> {
+    pub engine: &'a str,
+    pub python: &'a str,
+    pub script: &'a Path,
+    pub settle_s: f64,
 }
 
-/// [`judge_with`], and the engine's verdict from every nudged composed pose as well
-/// ([`MjScene::nudged`]; 8 more runs a free body: for verdict disagreements, to tell a
-/// verdict the engine itself flips under a 0.5 mm / 0.5° nudge from one it holds). Only the
-/// PhysX script answers it.
-pub fn judge_nudged(
-    engine: &str,
-    python: &str,
-    script: &Path,
-    scenes: &[(Generated, Ours, PathBuf)],
-    settle_s: f64,
-) -> Result<Vec<Judged>> {
-    run_judge(engine, python, script, scenes, settle_s, true)
+impl<'a> Judge<'a> {
+    /// The judge with our default settle cap ([`crate::physics::SettleOptions`]).
+    pub fn new(engine: &'a str, python: &'a str, script: &'a Path) -> Self {
+        Judge {
+            engine,
+            python,
+            script,
+            settle_s: crate::physics::SettleOptions::default().settle_max_time,
+        }
+    }
+
+    /// The engine's answers on exported scenes (`scenes[i].2` holds the export of
+    /// `scenes[i].0`).
+    pub fn run(&self, scenes: &[(Generated, Ours, PathBuf)]) -> Result<Vec<Judged>> {
+        run_judge(self, scenes, false)
+    }
+
+    /// [`Judge::run`], and the engine's verdict from every nudged composed pose as well
+    /// ([`MjScene::nudged`]; 8 more runs a free body: for verdict disagreements, to tell a
+    /// verdict the engine itself flips under a 0.5 mm / 0.5° nudge from one it holds). Only
+    /// the PhysX script answers it.
+    pub fn nudged(&self, scenes: &[(Generated, Ours, PathBuf)]) -> Result<Vec<Judged>> {
+        run_judge(self, scenes, true)
+    }
 }
 
-fn run_judge(
-    engine: &str,
-    python: &str,
-    script: &Path,
-    scenes: &[(Generated, Ours, PathBuf)],
-    settle_s: f64,
-    nudge: bool,
-) -> Result<Vec<Judged>> {
+fn run_judge(j: &Judge, scenes: &[(Generated, Ours, PathBuf)], nudge: bool) -> Result<Vec<Judged>> {
+    let Judge {
+        engine,
+        python,
+        script,
+        settle_s,
+    } = *j;
     let list: Vec<serde_json::Value> = scenes
         .iter()
         .map(|(_, o, d)| {
