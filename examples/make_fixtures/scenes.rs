@@ -380,7 +380,6 @@ pub(crate) fn box_tray(root: &Path) {
     let (ext, w, rim) = ([0.30, 0.20], 0.006, 0.018);
     let tray = shapes::tray(ext, w, rim);
     let bx = V3::new(0.12, 0.08, 0.05);
-    let cube = shapes::cuboid(bx);
     let cz = w + GAP + bx.z / 2.0;
     let objs = [
         Obj::new(
@@ -395,18 +394,14 @@ pub(crate) fn box_tray(root: &Path) {
             shapes::checker_texture(TEX, 8, [120, 130, 140], [170, 180, 190], "tray checker"),
             pose(V3::zeros(), yaw(0.0)),
         ),
-        Obj::new(
-            "box",
-            "box",
-            format!("shapes::cuboid({} x {} x {})", bx.x, bx.y, bx.z),
-            cube,
-            UvProjection::Box { tile: 0.12 },
-            shapes::checker_texture(TEX, 4, [190, 150, 100], [160, 120, 75], "cardboard"),
-            pose(V3::new(0.02, -0.01, cz), yaw(15.0)),
+        checker_box(
+            bx,
+            ([190, 150, 100], [160, 120, 75], "cardboard"),
+            V3::new(0.02, -0.01, cz),
+            15.0,
         ),
     ];
-    let margin = face_rest_margin(&objs[1].world_z());
-    assert!(margin > 0.01);
+    let margin = resting_box_margin(&objs[1]);
     let facts = format!(
         "Expected outcome: **passes**. The tray stands on the ground (z = 0); its flat inner floor is at z = {} mm, rim top at {} mm. The box ({} × {} × {} mm, turned 15° about z) rests flat on the floor with a {} mm gap: centre at z = {} + {} + {} = **{} mm**, (x, y) = (20, −10) mm; its centre of mass projects {} mm inside its bottom face. Poses: the tray uses translation + quaternion, the box a 4×4 matrix.",
         mm(w),
@@ -421,20 +416,13 @@ pub(crate) fn box_tray(root: &Path) {
         mm(cz),
         mm(margin)
     );
-    let pairs = write_manifest(
-        &root.join("box_tray"),
+    write_box_on(
+        root,
         "box_tray",
-        &[
-            (&objs[0], PoseForm::Parts, json!({ "friction": 0.8 })),
-            (&objs[1], PoseForm::Matrix, json!({ "friction": 0.8 })),
-        ],
+        &objs,
+        PoseForm::Matrix,
         "A cardboard box resting on a flat tray with a raised rim. Each OBJ has a PNG texture (`map_Kd`).",
         &facts,
-    );
-    assert!(
-        (pairs[0].2 - GAP).abs() < 1e-9,
-        "box-tray gap {}",
-        pairs[0].2
     );
 }
 
@@ -443,7 +431,6 @@ pub(crate) fn shelf_item(root: &Path) {
     let levels = [0.05, 0.30, 0.55];
     let shelf = shapes::shelf(w, d, h, t, &levels);
     let bx = V3::new(0.12, 0.08, 0.10);
-    let cube = shapes::cuboid(bx);
     let (cx, cy) = (0.03, 0.01);
     let cz = levels[1] + GAP + bx.z / 2.0;
     let objs = [
@@ -459,18 +446,14 @@ pub(crate) fn shelf_item(root: &Path) {
             shapes::stripes_texture(TEX, 8, [150, 105, 60], [175, 130, 80], "wood grain"),
             pose(V3::zeros(), yaw(0.0)),
         ),
-        Obj::new(
-            "box",
-            "box",
-            format!("shapes::cuboid({} x {} x {})", bx.x, bx.y, bx.z),
-            cube,
-            UvProjection::Box { tile: 0.12 },
-            shapes::checker_texture(TEX, 4, [60, 110, 170], [40, 80, 130], "blue box"),
-            pose(V3::new(cx, cy, cz), yaw(20.0)),
+        checker_box(
+            bx,
+            ([60, 110, 170], [40, 80, 130], "blue box"),
+            V3::new(cx, cy, cz),
+            20.0,
         ),
     ];
-    let margin = face_rest_margin(&objs[1].world_z());
-    assert!(margin > 0.01);
+    let margin = resting_box_margin(&objs[1]);
     let facts = format!(
         "Expected outcome: **passes**. The shelf ({} × {} × {} mm, open front and back) stands on its two side panels on the ground (z = 0). Its boards are {} mm thick with their top faces at z = {}, {} and {} mm; the cavity between the middle and the top board is {} mm high and {} mm wide. The box ({} × {} × {} mm, turned 20° about z) rests flat on the middle board with a {} mm gap: centre at z = {} + {} + {} = **{} mm**, (x, y) = ({}, {}) mm; its centre of mass projects {} mm inside its bottom face. A single convex hull of the shelf would fill the cavity and swallow the box.",
         mm(w),
@@ -494,19 +477,63 @@ pub(crate) fn shelf_item(root: &Path) {
         mm(cy),
         mm(margin)
     );
-    let pairs = write_manifest(
-        &root.join("shelf_item"),
+    write_box_on(
+        root,
         "shelf_item",
-        &[
-            (&objs[0], PoseForm::Parts, json!({ "friction": 0.8 })),
-            (&objs[1], PoseForm::Parts, json!({ "friction": 0.8 })),
-        ],
+        &objs,
+        PoseForm::Parts,
         "A blue box standing on the middle board of an open wooden shelf. Each OBJ has a PNG texture (`map_Kd`).",
         &facts,
     );
+}
+
+/// The box of the two manifest scenes where a box rests on a support: a `bx` cuboid with a
+/// checker texture (`colours`: two RGB tones and the texture's name), centred at `at` and turned
+/// `yaw_deg` about z.
+fn checker_box(bx: V3, colours: ([u8; 3], [u8; 3], &str), at: V3, yaw_deg: f64) -> Obj {
+    Obj::new(
+        "box",
+        "box",
+        format!("shapes::cuboid({} x {} x {})", bx.x, bx.y, bx.z),
+        shapes::cuboid(bx),
+        UvProjection::Box { tile: 0.12 },
+        shapes::checker_texture(TEX, 4, colours.0, colours.1, colours.2),
+        pose(at, yaw(yaw_deg)),
+    )
+}
+
+/// How far (metres) the box's centre of mass projects inside its bottom face; more than 1 cm, or
+/// the scene would not rest.
+fn resting_box_margin(bx: &Obj) -> f64 {
+    let margin = face_rest_margin(&bx.world_z());
+    assert!(margin > 0.01, "{}: rest margin {margin}", bx.key);
+    margin
+}
+
+/// Writes a manifest scene `name` of a support (`objs[0]`, pose as translation + quaternion) and
+/// the box resting on it (`objs[1]`, pose written as `box_form`), both with friction 0.8, and
+/// checks the box's gap to the support as written is `GAP`.
+fn write_box_on(
+    root: &Path,
+    name: &str,
+    objs: &[Obj; 2],
+    box_form: PoseForm,
+    description: &str,
+    facts: &str,
+) {
+    let pairs = write_manifest(
+        &root.join(name),
+        name,
+        &[
+            (&objs[0], PoseForm::Parts, json!({ "friction": 0.8 })),
+            (&objs[1], box_form, json!({ "friction": 0.8 })),
+        ],
+        description,
+        facts,
+    );
     assert!(
         (pairs[0].2 - GAP).abs() < 1e-9,
-        "box-shelf gap {}",
+        "{name}: box-support gap {}",
         pairs[0].2
     );
 }
