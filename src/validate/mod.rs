@@ -109,6 +109,20 @@ pub struct Check {
     pub message: String,
 }
 
+impl Check {
+    /// A check that passes when `value` is at most `limit`.
+    fn at_most(name: &str, subject: String, value: f64, limit: f64, message: String) -> Check {
+        Check {
+            name: name.into(),
+            subject,
+            passed: value <= limit,
+            value,
+            limit,
+            message,
+        }
+    }
+}
+
 /// The validation of one scene.
 #[derive(Clone, Debug, Serialize)]
 pub struct Validation {
@@ -196,34 +210,32 @@ pub fn validate(a: &Assembly, opts: &ValidateOptions) -> Result<Validation> {
         let v = visual.as_ref().map(|v| v[k].metrics);
         if let Some(v) = &v {
             let depth = v.max_penetration_depth;
-            checks.push(Check {
-                name: "visual_penetration".into(),
-                subject: format!("{na}/{nb}"),
-                passed: depth <= opts.max_visual_penetration,
-                value: depth,
-                limit: opts.max_visual_penetration,
-                message: format!(
+            checks.push(Check::at_most(
+                "visual_penetration",
+                format!("{na}/{nb}"),
+                depth,
+                opts.max_visual_penetration,
+                format!(
                     "visual meshes interpenetrate by {:.3} mm (R_volume {:.2e}, R_surface {:.2e}; limit {:.3} mm)",
                     depth * 1e3,
                     v.r_volume,
                     v.r_surface,
                     opts.max_visual_penetration * 1e3
                 ),
-            });
+            ));
         }
         let depth = c.metrics.max_penetration_depth;
-        checks.push(Check {
-            name: "static_penetration".into(),
-            subject: format!("{na}/{nb}"),
-            passed: depth <= opts.max_collision_penetration,
-            value: depth,
-            limit: opts.max_collision_penetration,
-            message: format!(
+        checks.push(Check::at_most(
+            "static_penetration",
+            format!("{na}/{nb}"),
+            depth,
+            opts.max_collision_penetration,
+            format!(
                 "collision hulls penetrate by {:.3} mm at the composed pose (limit {:.3} mm)",
                 depth * 1e3,
                 opts.max_collision_penetration * 1e3
             ),
-        });
+        ));
         pairs.push(PairReport {
             a: na.clone(),
             b: nb.clone(),
