@@ -48,7 +48,7 @@ NUDGE_DEG = 0.5
 
 # The PhysX driver's helpers (this folder is the script's own, first on sys.path).
 from check_usd import quat_angle_deg as angle_deg
-from check_usd import read_rigid_bodies, stdout_to_stderr
+from check_usd import read_rigid_bodies, start_physx, stdout_to_stderr
 
 
 def wxyz(q):
@@ -232,22 +232,10 @@ def main():
     with open(sys.argv[1]) as f:
         entries = json.load(f)
     with stdout_to_stderr():
-        import ovphysx
-        import ovstage
         import physx_usd_schemas
-        from ovphysx import PhysX
-        from ovphysx.samples.python_samples.schema_support import physx_schema_paths
-        from ovphysx.types import GlobalConfigKey
 
         physx_usd_schemas.register_all()
-        ovphysx.set_global_config(GlobalConfigKey.NUM_THREADS, 0)
-        PhysX.set_cpu_mode(True)
-        roots = [str(p) for p in physx_schema_paths()]
-        try:
-            roots.append(str(ovphysx.newton_schema_root()))
-        except FileNotFoundError:
-            pass
-        ovstage.population.register_usd_schemas(roots)
+        start_physx()
     for e in entries:
         with stdout_to_stderr():
             res = judge(e)

@@ -201,12 +201,14 @@ def read_rigid_bodies(physx, attrs):
     return rows
 
 
-def run_physx(out, seconds, dt):
+def start_physx():
+    """PhysX on the CPU (ovphysx's thread default), with the PhysX schemas (and Newton's, when
+    ovphysx ships them) registered with ovstage; the PhysX drivers' shared start."""
     import ovphysx
     import ovstage
     from ovphysx import PhysX
     from ovphysx.samples.python_samples.schema_support import physx_schema_paths
-    from ovphysx.types import GlobalConfigKey, SimObjectType
+    from ovphysx.types import GlobalConfigKey
 
     ovphysx.set_global_config(GlobalConfigKey.NUM_THREADS, 0)
     PhysX.set_cpu_mode(True)
@@ -216,6 +218,14 @@ def run_physx(out, seconds, dt):
     except FileNotFoundError:
         pass
     ovstage.population.register_usd_schemas(roots)
+
+
+def run_physx(out, seconds, dt):
+    import ovstage
+    from ovphysx import PhysX
+    from ovphysx.types import SimObjectType
+
+    start_physx()
     physx = PhysX()
     stage = ovstage.Stage("interact3d-check")
     ovstage.population.open_usd(
