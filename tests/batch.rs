@@ -8,7 +8,7 @@ mod common;
 use batch_data::{make_dataset, Made, Spec};
 use common::*;
 use serde_json::Value;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
 /// Validation settings that keep the tests fast (R_volume on 20k points instead of 1M).
@@ -28,22 +28,35 @@ fn batch(root: &Path, out: &Path, extra: &[&str]) -> (i32, String, String) {
     run(&args)
 }
 
+/// A generated dataset in a new temporary folder: (the folder, its `data` root, the scenes made).
+fn dataset(good: usize, failing: usize, broken: bool) -> (tempfile::TempDir, PathBuf, Vec<Made>) {
+    let t = tempfile::tempdir().unwrap();
+    let root = t.path().join("data");
+    let made = make_dataset(
+        &root,
+        Spec {
+            good,
+            failing,
+            broken,
+        },
+    );
+    (t, root, made)
+}
+
+/// `batch --list` with `extra` options: the selected scenes, one relative path each.
+fn list(root: &Path, out: &Path, extra: &[&str]) -> Vec<String> {
+    let (code, stdout, err) = batch(root, out, &[&["--list"], extra].concat());
+    assert_eq!(code, 0, "{err}");
+    stdout.lines().map(str::to_string).collect()
+}
+
 fn rows(summary: &Value) -> &Vec<Value> {
     summary["scenes"].as_array().unwrap()
 }
 
 #[test]
 fn converts_good_scenes_reports_broken_ones_and_a_rerun_reuses_them() {
-    let t = tempfile::tempdir().unwrap();
-    let root = t.path().join("data");
-    let made = make_dataset(
-        &root,
-        Spec {
-            good: 9,
-            failing: 1,
-            broken: true,
-        },
-    );
+    let (t, root, made) = dataset(9, 1, true);
     assert_eq!(made.len(), 12);
     let out = t.path().join("out");
 
@@ -212,22 +225,9 @@ fn slurm_task(root: &Path, out: &Path, id: usize, max: usize) -> std::process::C
 /// for the times. Also #36: the merged files are readable by others (0644 under umask 022).
 #[test]
 fn shards_cover_every_scene_exactly_once_and_merge_back() {
-    let t = tempfile::tempdir().unwrap();
-    let root = t.path().join("data");
-    let made = make_dataset(
-        &root,
-        Spec {
-            good: 9,
-            failing: 1,
-            broken: true,
-        },
-    );
+    let (t, root, made) = dataset(9, 1, true);
     let out = t.path().join("out");
-    let list = |extra: &[&str]| -> Vec<String> {
-        let (code, stdout, err) = batch(&root, &out, &[&["--list"], extra].concat());
-        assert_eq!(code, 0, "{err}");
-        stdout.lines().map(str::to_string).collect()
-    };
+    let list = |extra: &[&str]| list(&root, &out, extra);
     let all = list(&[]);
     assert_eq!(all, made.iter().map(|m| m.rel.clone()).collect::<Vec<_>>());
     let parts: Vec<Vec<String>> = (1..=3)
@@ -409,16 +409,7 @@ fn stable_html(html: &str) -> (String, Value) {
 
 #[test]
 fn a_run_killed_midway_then_resumed_equals_one_clean_run() {
-    let t = tempfile::tempdir().unwrap();
-    let root = t.path().join("data");
-    let made = make_dataset(
-        &root,
-        Spec {
-            good: 6,
-            failing: 1,
-            broken: true,
-        },
-    );
+    let (t, root, made) = dataset(6, 1, true);
     let clean = t.path().join("clean");
     let (code_clean, _, err) = batch(&root, &clean, &["--jobs", "1"]);
     assert_eq!(code_clean, 2, "{err}");
@@ -494,22 +485,9 @@ fn a_run_killed_midway_then_resumed_equals_one_clean_run() {
 
 #[test]
 fn filters_and_usage_errors() {
-    let t = tempfile::tempdir().unwrap();
-    let root = t.path().join("data");
-    make_dataset(
-        &root,
-        Spec {
-            good: 9,
-            failing: 0,
-            broken: false,
-        },
-    );
+    let (t, root, _) = dataset(9, 0, false);
     let out = t.path().join("out");
-    let list = |extra: &[&str]| {
-        let (code, stdout, err) = batch(&root, &out, &[&["--list"], extra].concat());
-        assert_eq!(code, 0, "{err}");
-        stdout.lines().map(str::to_string).collect::<Vec<_>>()
-    };
+    let list = |extra: &[&str]| list(&root, &out, extra);
     assert_eq!(
         list(&["--include", "outputs/{food,toys}/**"]),
         [
