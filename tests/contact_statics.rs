@@ -292,7 +292,12 @@ fn a_cylinder_rocking_on_its_rim_never_tilts_past_its_release_angle() {
 /// A cylinder of `sides` sides (r 2 cm, 10 cm long, 0.2 kg, axis along y) lying on a fixed
 /// plate turned by `deg` about y, friction 0.6 on both: it can only roll down the slope (along x).
 fn cylinder_on_incline(deg: f64, sides: usize) -> Vec<SimBody> {
-    let mut v = block_on_incline(deg, 0.6);
+    cylinder_on_incline_mu(deg, sides, 0.6)
+}
+
+/// [`cylinder_on_incline`] with sliding friction `mu` on both.
+fn cylinder_on_incline_mu(deg: f64, sides: usize, mu: f64) -> Vec<SimBody> {
+    let mut v = block_on_incline(deg, mu);
     let (r, l, m) = (0.02, 0.1, 0.2);
     let rot = UnitQuaternion::from_axis_angle(&Vector3::y_axis(), deg.to_radians());
     let up = rot * Vector3::z();
@@ -304,7 +309,7 @@ fn cylinder_on_incline(deg: f64, sides: usize) -> Vec<SimBody> {
             Translation3::from(Vector3::new(0.0, 0.0, 0.1) - up * 0.01),
             rot,
         ),
-        0.6,
+        mu,
     );
     // The cylinder's axis (its z) along y; a face, not a vertex, down: slices at ±π/sides.
     let half = std::f64::consts::PI / sides as f64;
@@ -319,7 +324,7 @@ fn cylinder_on_incline(deg: f64, sides: usize) -> Vec<SimBody> {
         mass: m,
         com: P3::origin(),
         inertia: cylinder_inertia(m, r, l),
-        friction: 0.6,
+        friction: mu,
         fixed: false,
     };
     v
@@ -436,6 +441,61 @@ fn a_cylinder_on_an_incline_is_held_where_mujoco_holds_it_and_rolls_where_it_rol
                     held,
                     "MuJoCo at {f} θ_c ({deg:.3}°) moved {:.2e} m in 1–3 s",
                     mj[k]
+                );
+            }
+        }
+    }
+}
+
+#[test]
+fn a_cylinder_carrying_friction_has_less_rolling_left_as_in_mujocos_elliptic_cone() {
+    // MuJoCo's elliptic cone (`cone="elliptic"`, the export's) is one bound over every friction
+    // dimension of a contact: (f_t / μ)² + (τ_r / μ_r)² ≤ N² (torsion aside). A cylinder held
+    // on an incline carries f_t = N tan θ and τ_r = N r tan θ, so it stays while
+    // (tan θ / μ)² + (r tan θ / μ_r)² ≤ 1: below θ_c = atan(μ_r / r) when μ is small. The
+    // 512-gon, r 2 cm, μ_r 2 mm (θ_c 5.71°): with μ 0.1 it holds only to 4.04°, with μ 0.15 to
+    // 4.76°; a bound of μ_r N alone (session 19's) held all four angles below θ_c.
+    let (r, mu_r): (f64, f64) = (0.02, 0.002);
+    let theta_c = (mu_r / r).atan().to_degrees();
+    // (sliding friction, fraction of θ_c)
+    let cases = [(0.1, 0.6), (0.1, 0.8), (0.15, 0.8), (0.15, 0.9)];
+    for (mu, f) in cases {
+        let deg = f * theta_c;
+        let t = deg.to_radians().tan();
+        let held = (t / mu).powi(2) + (r * t / mu_r).powi(2) <= 1.0;
+        if common::python_or_skip("shared cone against MuJoCo") {
+            let args = [
+                "--mu".to_string(),
+                mu.to_string(),
+                "512".into(),
+                mu_r.to_string(),
+                deg.to_string(),
+            ];
+            let args: Vec<&str> = args.iter().map(|s| s.as_str()).collect();
+            let v = common::python_json("incline_mujoco.py", &args);
+            let mj = v["moved"][0].as_f64().unwrap();
+            assert_eq!(
+                mj < 1e-6,
+                held,
+                "MuJoCo, μ {mu}, {f} θ_c ({deg:.3}°): moved {mj:.2e} m in 1–3 s"
+            );
+        }
+        for turn in [1.0, 0.01] {
+            let opts = SettleOptions {
+                rolling_friction: mu_r,
+                contact_reuse_max_turn_deg: turn,
+                ..awake()
+            };
+            let (d, _) = motion(&cylinder_on_incline_mu(deg, 512, mu), &opts, 1, 1.0, 3.0);
+            if held {
+                assert!(
+                    d < 1e-6,
+                    "{turn}°, μ {mu}, {f} θ_c ({deg:.3}°): crept {d:.2e} m"
+                );
+            } else {
+                assert!(
+                    d > 0.05,
+                    "{turn}°, μ {mu}, {f} θ_c ({deg:.3}°): moved only {d:.4} m"
                 );
             }
         }

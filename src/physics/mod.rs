@@ -234,7 +234,9 @@ pub struct SettleOptions {
     /// not kept (docs/agreement.md "Thirteenth stop", and with the resistance's `N` corrected
     /// "Fourteenth stop": verdict 684, rest 372 of 376, against main's 687 and 376 of 377; with
     /// the resistance held within the step, "Fifteenth stop": verdicts 313, 396, 654 fixed, 402
-    /// lost, the rests of 137, 233, 460 lost, so not kept either).
+    /// lost, the rests of 137, 233, 460 lost, so not kept either; with the hold's bound shared
+    /// with sliding as in MuJoCo's elliptic cone, "Sixteenth stop": verdict 687 as main, rest
+    /// 372 of 379, not kept).
     pub contact_reuse_max_turn_deg: f64,
     /// Rolling friction (m, MuJoCo's third `friction` value): two bodies in contact (or a body
     /// and the floor) resist rolling on each other with a torque of at most this times their

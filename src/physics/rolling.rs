@@ -17,6 +17,11 @@
 //!   without slipping, so the contact's friction does not hand the rolling back) that keeps
 //!   the step's total within `μ_r·J`; Gauss–Seidel over the pairs, a body's pairs sharing it.
 //!
+//! `J` is shared with sliding as in MuJoCo's elliptic cone (`cone="elliptic"`, the export's):
+//! each manifold's normal impulse is scaled by `√(1 − (f_t / μ N)²)` ([`cone_share`]), so a
+//! contact near its sliding limit has little rolling left (`tests/contact_statics.rs`, the
+//! incline with μ 0.1 and 0.15, against MuJoCo's own verdict; docs/agreement.md "Sixteenth stop").
+//!
 //! The torque alone, corrected one step late (session 17's), crept 2–30 µm in 2 s on the
 //! incline below θ_c where MuJoCo holds still (docs/agreement.md "Fifteenth stop").
 //! Spin about the normal is not included (Rapier's contacts carry a twist friction already).
@@ -31,6 +36,10 @@ use std::collections::{BTreeMap, HashMap};
 pub(super) struct Rolling {
     /// Rolling friction (m); 0: off.
     mu: Real,
+    /// Coulomb friction per contact point (Rapier's `FrictionModel::Coulomb`): each solver point
+    /// stores its own friction impulse; else (the twist model) the manifold's one friction
+    /// impulse is stored on every point of it.
+    coulomb: bool,
     /// Body index of each rigid-body handle (the floor's absent); only looked up, never iterated.
     index: HashMap<RigidBodyHandle, usize>,
     /// Torque on the pair's first body (its opposite on the second), by pair `(a, b)`, `a < b`.
@@ -42,6 +51,9 @@ pub(super) struct Rolling {
 struct PairContact {
     /// Sum of the contacts' normal impulses (N·s).
     impulse: Real,
+    /// The part of `impulse` the shared cone leaves to rolling (N·s): each manifold's normal
+    /// impulse times `√(1 − (|f_t| / μ N)²)` ([`cone_share`]).
+    budget: Real,
     /// Impulse-weighted sum of the normals, from the pair's first body towards its second.
     normal: Vector,
     /// Impulse-weighted sum of the contact points (world, midway between the two surfaces).
@@ -49,9 +61,10 @@ struct PairContact {
 }
 
 impl Rolling {
-    pub(super) fn new(mu: Real, handles: &[RigidBodyHandle]) -> Self {
+    pub(super) fn new(mu: Real, coulomb: bool, handles: &[RigidBodyHandle]) -> Self {
         Rolling {
             mu,
+            coulomb,
             index: handles.iter().enumerate().map(|(i, &h)| (h, i)).collect(),
             torques: BTreeMap::new(),
         }
@@ -87,21 +100,38 @@ impl Rolling {
                 let (pos1, pos2) = (*c1.position(), *c2.position());
                 let mut impulse = 0.0;
                 let mut point = Vector::ZERO;
+                // The last substep's normal and friction impulses (the shared cone's load).
+                let (mut last, mut friction) = (0.0, Vector::ZERO);
+                let mut budget = 0.0;
                 for c in &m.data.solver_contacts {
                     if let Some(p) = m.points.get(c.contact_indices()[0] as usize) {
                         impulse += p.data.impulse;
                         let at = 0.5
                             * (pos1.transform_point(p.local_p1) + pos2.transform_point(p.local_p2));
                         point += at * p.data.impulse;
+                        if self.coulomb {
+                            let share = cone_share(
+                                p.data.warmstart_tangent_world.length(),
+                                m.data.friction * p.data.warmstart_impulse,
+                            );
+                            budget += p.data.impulse * share;
+                        } else {
+                            last += p.data.warmstart_impulse;
+                            friction = p.data.warmstart_tangent_world;
+                        }
                     }
                 }
                 if impulse <= 0.0 {
                     continue;
                 }
+                if !self.coulomb {
+                    budget = impulse * cone_share(friction.length(), m.data.friction * last);
+                }
                 // The manifold's normal points from its first collider towards its second.
                 let (key, sign) = if i < j { ((i, j), 1.0) } else { ((j, i), -1.0) };
                 let e = pairs.entry(key).or_default();
                 e.impulse += impulse;
+                e.budget += budget;
                 e.normal += m.data.normal * (sign * impulse);
                 e.point += point;
             }
@@ -119,12 +149,13 @@ impl Rolling {
         let acting: Vec<((usize, usize), Vector, Vector, Real)> = pairs
             .iter()
             .filter(|(&(a, b), _)| moving(a) || moving(b))
-            .filter_map(|(&key, c)| Some((key, unit(c.normal)?, c.point / c.impulse, c.impulse)))
+            .filter_map(|(&key, c)| Some((key, unit(c.normal)?, c.point / c.impulse, c.budget)))
             .collect();
         // The hold, within the step: the rolling that the step left is cancelled now, before
         // the next position update, by an angular impulse about the contact point that keeps
         // each pair's total for the step (the kept torque's share included) within μ_r·J, J
-        // the step's normal impulse. Gauss–Seidel over the pairs (a body's pairs share it).
+        // the step's normal impulse, less what the contacts' friction takes of the shared cone
+        // (`budget`). Gauss–Seidel over the pairs (a body's pairs share it).
         let mut held: BTreeMap<(usize, usize), Vector> = acting
             .iter()
             .map(|&(key, nrm, _, _)| {
@@ -133,7 +164,7 @@ impl Rolling {
             })
             .collect();
         for _ in 0..HOLD_SWEEPS {
-            for &((a, b), nrm, at, impulse) in &acting {
+            for &((a, b), nrm, at, budget) in &acting {
                 let w = angvel(world, handles, n, a) - angvel(world, handles, n, b);
                 let roll = w - nrm * nrm.dot(w);
                 let Some(d) = unit(roll) else {
@@ -151,7 +182,7 @@ impl Rolling {
                 let acc = held.entry((a, b)).or_insert(Vector::ZERO);
                 let mut next = *acc - roll / k;
                 next -= nrm * nrm.dot(next);
-                let limit = self.mu * impulse;
+                let limit = self.mu * budget;
                 let size = next.length();
                 if size > limit {
                     next *= limit / size;
@@ -187,6 +218,20 @@ impl Rolling {
         }
         self.torques = torques;
     }
+}
+
+/// The share of a contact's normal force that MuJoCo's elliptic cone (`cone="elliptic"`, as the
+/// MJCF export writes) leaves to rolling when the contact's friction carries `tangent` against
+/// a sliding limit `limit` (μ N, the same substep's): the cone is one bound over every friction
+/// dimension, `(f_t / μ)² + (τ_r / μ_r)² ≤ N²`, so `|τ_r| ≤ μ_r N √(1 − (f_t / μ N)²)`.
+/// (MuJoCo's cone has the torsion `τ_n / μ_t` in it too; Rapier's twist friction is bounded
+/// by its own rule, not MuJoCo's `μ_t`, so it is left out.)
+fn cone_share(tangent: Real, limit: Real) -> Real {
+    if limit <= 0.0 {
+        return 1.0;
+    }
+    let load = (tangent / limit).min(1.0);
+    (1.0 - load * load).sqrt()
 }
 
 /// Gauss–Seidel sweeps of the hold over a step's pairs.

@@ -207,7 +207,7 @@ impl<'a> Sim<'a> {
                 .restitution(opts.restitution),
             Some(floor),
         );
-        let rolling = rolling::Rolling::new(opts.rolling_friction, &handles);
+        let rolling = rolling::Rolling::new(opts.rolling_friction, opts.coulomb_friction, &handles);
         Ok(Sim {
             rolling,
             bodies,

@@ -2,10 +2,10 @@
 SIDES facets (r 2 cm, 10 cm long, 0.2 kg, its axis across the slope, a face down) on a fixed
 plate tilted by each DEG, with the contact settings of the MJCF export (templates/scene.xml.j2:
 timestep 0.002, implicitfast, elliptic cone, noslip_iterations 10, solref 0.004 1, solimp
-0.95 0.99 0.001, condim 6, friction 0.6 0.005 MU_R). Prints JSON: {"moved": [m, ...]}, the
-distance the cylinder's centre moved from 1 s to 3 s at each DEG.
+0.95 0.99 0.001, condim 6, friction MU 0.005 MU_R, MU 0.6 unless given). Prints JSON: {"moved":
+[m, ...]}, the distance the cylinder's centre moved from 1 s to 3 s at each DEG.
 
-Usage: incline_mujoco.py SIDES MU_R DEG [DEG ...]"""
+Usage: incline_mujoco.py [--mu MU] SIDES MU_R DEG [DEG ...]"""
 import json
 import math
 import sys
@@ -14,7 +14,7 @@ import mujoco
 import numpy as np
 
 
-def scene(sides, mu_r, deg):
+def scene(sides, mu_r, deg, mu=0.6):
     r, length, m = 0.02, 0.1, 0.2
     half = math.pi / sides
     pts = []
@@ -29,7 +29,7 @@ def scene(sides, mu_r, deg):
     q = f"{math.cos(th / 2)} 0 {math.sin(th / 2)} 0"
     return f"""<mujoco><compiler inertiafromgeom="false"/>
 <option timestep="0.002" gravity="0 0 -9.81" integrator="implicitfast" cone="elliptic" noslip_iterations="10"/>
-<default><default class="c"><geom condim="6" solref="0.004 1" solimp="0.95 0.99 0.001" friction="0.6 0.005 {mu_r}"/></default></default>
+<default><default class="c"><geom condim="6" solref="0.004 1" solimp="0.95 0.99 0.001" friction="{mu} 0.005 {mu_r}"/></default></default>
 <asset><mesh name="cyl" vertex="{' '.join(pts)}"/></asset>
 <worldbody>
 <geom type="box" size="2 0.2 0.01" pos="{-0.01 * up[0]} 0 {-0.01 * up[2]}" quat="{q}" class="c"/>
@@ -38,8 +38,8 @@ def scene(sides, mu_r, deg):
 </worldbody></mujoco>"""
 
 
-def moved(sides, mu_r, deg):
-    m = mujoco.MjModel.from_xml_string(scene(sides, mu_r, deg))
+def moved(sides, mu_r, deg, mu=0.6):
+    m = mujoco.MjModel.from_xml_string(scene(sides, mu_r, deg, mu))
     d = mujoco.MjData(m)
 
     def at(t):
@@ -52,5 +52,9 @@ def moved(sides, mu_r, deg):
 
 
 if __name__ == "__main__":
-    sides, mu_r = int(sys.argv[1]), float(sys.argv[2])
-    print(json.dumps({"moved": [moved(sides, mu_r, float(x)) for x in sys.argv[3:]]}))
+    args = sys.argv[1:]
+    mu = 0.6
+    if args[:1] == ["--mu"]:
+        mu, args = float(args[1]), args[2:]
+    sides, mu_r = int(args[0]), float(args[1])
+    print(json.dumps({"moved": [moved(sides, mu_r, float(x), mu) for x in args[2:]]}))
