@@ -9,7 +9,7 @@
 use interact3d::compose::cloud::Cloud;
 use interact3d::compose::colour;
 use interact3d::compose::colour_axis::{
-    fit, ColourProfile, FitOptions, ProfileFit, GUIDANCE_BINS, MODEL_BINS,
+    fit, fit_edges, ColourProfile, FitOptions, ProfileFit, GUIDANCE_BINS, MODEL_BINS,
 };
 use interact3d::compose::obb::{self, Obb};
 use interact3d::compose::ObjectInput;
@@ -63,6 +63,11 @@ pub fn print(id: &str, seed: u64, inp: &ObjectInput, truth: &Similarity) {
         rel(s0),
         show(fit(&model, &gt, &o)),
         show(fit(&model, &go, &o)),
+    );
+    eprintln!(
+        "EDGES  {id:<44} seed {seed}: truth axis {}; own axis {}",
+        show(fit_edges(&model, &gt, &o)),
+        show(fit_edges(&model, &go, &o)),
     );
     if std::env::var_os("COLOUR_DUMP").is_some() {
         let inv = truth.matrix().try_inverse().unwrap();
