@@ -419,12 +419,6 @@ pub fn run(args: &[String]) {
                                     serde_json::to_string(cr).unwrap_or_default()
                                 );
                             }
-                            if let Some(b) = &r.blur {
-                                eprintln!(
-                                    "  BLUR {id:<44} (pair {k:2}, seed {seed}) {}",
-                                    serde_json::to_string(b).unwrap_or_default()
-                                );
-                            }
                             if let Some(sr) = &r.support {
                                 eprintln!(
                                     "  SUPPORTSTAGE {id:<44} (pair {k:2}, seed {seed}) {}",

@@ -25,7 +25,6 @@
 
 pub mod agent;
 pub mod bleed;
-pub mod blur;
 pub mod cloud;
 pub mod colour;
 pub mod colour_axis;
@@ -196,9 +195,6 @@ pub struct ObjectResult {
     /// The colour's refused size judged by the support ([`colour_rest`]).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub colour_rest: Option<colour_rest::ColourRestReport>,
-    /// The near-sphere's size with the scene's blur held ([`blur`]).
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub blur: Option<blur::BlurReport>,
 }
 
 #[derive(Clone, Copy, Debug, Serialize)]
@@ -500,8 +496,6 @@ pub fn compose(inputs: &[ObjectInput], o: &ComposeOptions) -> Result<Composition
     let mut placed_samples: Vec<Option<Vec<P3>>> = vec![None; inputs.len()];
     let mut field: Option<AnchorField> = None;
     let mut results = Vec::new();
-    // The scene's blur σ² and its standard error, measured on the anchor ([`blur`]).
-    let mut blur_sigma2: Option<(f64, f64)> = None;
     for (rank, &i) in order.iter().enumerate() {
         let inp = &inputs[i];
         let seed = name_seed(o.seed, &inp.name);
@@ -556,7 +550,6 @@ pub fn compose(inputs: &[ObjectInput], o: &ComposeOptions) -> Result<Composition
         let mut contact = None;
         let mut support = None;
         let mut colour_rest = None;
-        let mut blur = None;
         if let (Some(field), true) = (&field, rank > 0 && o.method.refines()) {
             let item = Item {
                 visual: &inp.visual,
@@ -566,10 +559,6 @@ pub fn compose(inputs: &[ObjectInput], o: &ComposeOptions) -> Result<Composition
                 guidance,
                 field,
             };
-            // A near-sphere's size with the scene's blur held ([`blur`]).
-            if let Some(b) = blur_sigma2 {
-                blur = Some(blur::apply(&item, b, &mut placed));
-            }
             // An item that does not rest on the placed objects: its size among resting poses.
             if let Some(so) = &o.support {
                 support = Some(support::apply(&item, so, &mut placed));
@@ -670,21 +659,6 @@ pub fn compose(inputs: &[ObjectInput], o: &ComposeOptions) -> Result<Composition
                 refinement = Some(RefineReport::from(&r));
             }
         }
-        if rank == 0 && o.method.refines() && order.len() > 1 {
-            let probe = guidance.subsample(1000).points;
-            let t = &placed.pose;
-            blur_sigma2 = blur::from_anchor(&object, &object_tree, spacing, &probe, t);
-            if let Some(v) = std::env::var("BLUR_SIGMA2")
-                .ok()
-                .and_then(|v| v.parse().ok())
-            {
-                blur_sigma2 = Some((v, 0.0));
-            }
-            if std::env::var_os("BLUR_ORACLE").is_some() {
-                let v = reconstruction::BLUR_ORACLE.load(std::sync::atomic::Ordering::SeqCst);
-                blur_sigma2 = Some((f64::from_bits(v), 0.0));
-            }
-        }
         if o.method.refines() && rank + 1 < order.len() {
             let mesh: Mesh = geometry().transformed(&placed.pose.matrix());
             let fld = field.get_or_insert_with(|| AnchorField::new(&[], 32));
@@ -713,7 +687,6 @@ pub fn compose(inputs: &[ObjectInput], o: &ComposeOptions) -> Result<Composition
             contact,
             support,
             colour_rest,
-            blur,
         });
     }
     Ok(Composition {

@@ -99,20 +99,6 @@ pub fn plane_icp_offset(
     init: Similarity,
     o: &PlaneIcpOptions,
 ) -> (Similarity, f64, f64) {
-    plane_icp_biased(object, matcher, guidance, init, o, &[])
-}
-
-/// [`plane_icp_offset`] with a known depth per object sample: sample `i`'s surface is expected
-/// `bias[i] / scale` (guidance units) inside the guidance (a blur's erosion, [`super::blur`]);
-/// an empty `bias` holds none.
-pub fn plane_icp_biased(
-    object: &Cloud,
-    matcher: &Matcher,
-    guidance: &Cloud,
-    init: Similarity,
-    o: &PlaneIcpOptions,
-    bias: &[f64],
-) -> (Similarity, f64, f64) {
     let mut t = init;
     let mut delta = 0.0f64;
     let mut rms = f64::INFINITY;
@@ -148,8 +134,7 @@ pub fn plane_icp_biased(
             .map(|&(_, gi, oi)| {
                 let p = m.transform_point(&object.points[oi]);
                 let nrm = t.rotation * object.normals[oi];
-                let b = bias.get(oi).map_or(0.0, |b| b / t.scale);
-                (p, nrm, nrm.dot(&(p - guidance.points[gi])) + delta - b)
+                (p, nrm, nrm.dot(&(p - guidance.points[gi])) + delta)
             })
             .collect();
         let mut abs: Vec<f64> = rows.iter().map(|r| r.2.abs()).collect();
@@ -238,12 +223,7 @@ pub fn surface_fit(
 /// units): the signed distance along `j`'s normal and `true` when the point lies within two
 /// spacings of `j`'s tangent plane's foot, else the distance to `j` itself and `false`; `None`
 /// for an empty tree. Shared by [`surface_distances`] and [`offset_distances`].
-pub(super) fn plane_distance(
-    object: &Cloud,
-    tree: &KdTree,
-    spacing: f64,
-    x: &P3,
-) -> Option<(f64, bool)> {
+fn plane_distance(object: &Cloud, tree: &KdTree, spacing: f64, x: &P3) -> Option<(f64, bool)> {
     let (j, d2) = tree.nearest(x)?;
     let along = (x - object.points[j]).dot(&object.normals[j]);
     let tangential = (d2 - along * along).max(0.0).sqrt();

@@ -337,9 +337,6 @@ fn unit_f(h: u64) -> f64 {
 }
 
 /// Guidance parts for a ground-truth scene (see the module doc).
-/// TEMPORARY oracle.
-pub static BLUR_ORACLE: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
-
 pub fn make(objects: &[TruthObject], seed: u64, o: &ReconOptions) -> Synthetic {
     let mut rng = Rng::new(seed ^ 0x5EC0_4517_0C7E_D000);
     let scene_bb = super::synth::scene_box(objects);
@@ -379,13 +376,6 @@ pub fn make(objects: &[TruthObject], seed: u64, o: &ReconOptions) -> Synthetic {
         .map(|_| o.triangles[0] + rng.below(o.triangles[1] - o.triangles[0] + 1))
         .sum();
     let sigma = rng.range(o.blur[0], o.blur[1]) * diag;
-    if std::env::var_os("BLUR_TRUTH").is_some() {
-        eprintln!("BLUR_TRUTH sigma2 {:e}", sigma * sigma);
-    }
-    BLUR_ORACLE.store(
-        (sigma * sigma).to_bits(),
-        std::sync::atomic::Ordering::SeqCst,
-    );
     let mut h = (3.0 * area / budget as f64).sqrt();
     let band_of = |h: f64| 3.0 * sigma + 3.0 * h;
     let dims_of = |h: f64| {
