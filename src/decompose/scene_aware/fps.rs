@@ -31,20 +31,20 @@ pub fn farthest_of(n: usize, at: impl Fn(usize) -> P3, k: usize) -> Vec<usize> {
     // (2× quicker than one pass for each on 500 points, 3× on 10,000). The farthest is then
     // found by value, the first of equals (`picks`, AVX2 where the processor has it).
     let padded = n.div_ceil(LANES) * LANES;
-    let (mut xs, mut ys, mut zs) = (vec![0.0; padded], vec![0.0; padded], vec![0.0; padded]);
-    // The centroid: the points' sum in their order, as a fold over them gives it. Written by
-    // slots (no `push`, with its length and capacity kept a point, issue #37).
-    let mut sum = V3::zeros();
-    for (i, ((x, y), z)) in xs[..n]
-        .iter_mut()
-        .zip(&mut ys[..n])
-        .zip(&mut zs[..n])
-        .enumerate()
-    {
-        let p = at(i);
-        sum += p.coords;
-        (*x, *y, *z) = (p.x, p.y, p.z);
-    }
+    // The points in a row (an exact-size collect: no capacity check a point), then each
+    // coordinate copied out and padded (issue #37: zeroed arrays written again, or a `push` a
+    // coordinate, cost more than these copies: `alloc_zeroed` read 5.8 k instructions an
+    // array on `00005`).
+    let pts: Vec<P3> = (0..n).map(at).collect();
+    let coordinate = |a: usize| {
+        let mut v = Vec::with_capacity(padded);
+        v.extend(pts.iter().map(|p| p[a]));
+        v.resize(padded, 0.0);
+        v
+    };
+    let (xs, ys, zs) = (coordinate(0), coordinate(1), coordinate(2));
+    // The centroid: the points' sum in their order, as a fold over them gives it.
+    let sum = pts.iter().fold(V3::zeros(), |s, p| s + p.coords);
     let c = sum / n as f64;
     let first = farthest_from(&xs[..n], &ys[..n], &zs[..n], &c);
     // The padding is at distance 0: never the farthest.
@@ -78,7 +78,7 @@ fn farthest_from(xs: &[f64], ys: &[f64], zs: &[f64], c: &V3) -> usize {
     }
     let whole = n / LANES * LANES;
     let mut lanes = [f64::NEG_INFINITY; LANES];
-    let mut at = [0usize; LANES];
+    let mut at = [0.0f64; LANES];
     for (ch, ((x, y), z)) in xs[..whole]
         .chunks_exact(LANES)
         .zip(ys[..whole].chunks_exact(LANES))
@@ -89,7 +89,7 @@ fn farthest_from(xs: &[f64], ys: &[f64], zs: &[f64], c: &V3) -> usize {
             let e = (V3::new(x[l], y[l], z[l]) - c).norm_squared();
             let up = e > lanes[l];
             lanes[l] = if up { e } else { lanes[l] };
-            at[l] = if up { ch } else { at[l] };
+            at[l] = if up { ch as f64 } else { at[l] };
         }
     }
     let mut far = lanes
@@ -97,7 +97,7 @@ fn farthest_from(xs: &[f64], ys: &[f64], zs: &[f64], c: &V3) -> usize {
         .fold(f64::NEG_INFINITY, |m: f64, &e| if e > m { e } else { m });
     let mut first = (0..LANES)
         .filter(|&l| whole > 0 && lanes[l] == far)
-        .map(|l| at[l] * LANES + l)
+        .map(|l| at[l] as usize * LANES + l)
         .min()
         .unwrap_or(0);
     for i in whole..n {
@@ -161,8 +161,11 @@ fn picks_body(
         // Each lane's largest and the chunk of its first occurrence: the first of equals
         // overall is then the lowest index among the lanes holding the largest, with no
         // second pass over the distances to find it.
+        // The chunk as a float (exact below 2⁵³): its select then takes the same mask as the
+        // distances' (with an integer one the compiler packed and unpacked the mask, 53
+        // instructions a chunk of eight against 45).
         let mut lanes = [0.0f64; LANES];
-        let mut at = [0usize; LANES];
+        let mut at = [0.0f64; LANES];
         for (c, (((d, x), y), z)) in dist
             .chunks_exact_mut(LANES)
             .zip(xs.chunks_exact(LANES))
@@ -177,7 +180,7 @@ fn picks_body(
                 d[l] = v;
                 let up = v > lanes[l];
                 lanes[l] = if up { v } else { lanes[l] };
-                at[l] = if up { c } else { at[l] };
+                at[l] = if up { c as f64 } else { at[l] };
             }
         }
         let far = lanes
@@ -188,7 +191,7 @@ fn picks_body(
         }
         last = (0..LANES)
             .filter(|&l| lanes[l] == far)
-            .map(|l| at[l] * LANES + l)
+            .map(|l| at[l] as usize * LANES + l)
             .min()
             .expect("far is a lane's largest");
         kept.push(last);
