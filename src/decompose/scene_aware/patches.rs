@@ -236,11 +236,10 @@ fn lloyd(
     iters: usize,
     first_dist: Option<&[f64]>,
 ) -> Vec<usize> {
-    lloyd_counted(feats, areas, centres, lambda2, iters, first_dist, true).0
+    lloyd_counted(feats, areas, centres, lambda2, iters, first_dist).0
 }
 
-/// [`lloyd`], and how many triangle-rounds its bounds skipped (for its tests); `elkan`: with
-/// the centre–centre bound (off, Hamerly's bounds alone, for the tests to compare).
+/// [`lloyd`], and how many triangle-rounds its bounds skipped (for its tests).
 fn lloyd_counted(
     feats: &[Feat],
     areas: &[f64],
@@ -248,7 +247,6 @@ fn lloyd_counted(
     lambda2: f64,
     iters: usize,
     first_dist: Option<&[f64]>,
-    elkan: bool,
 ) -> (Vec<usize>, usize) {
     let n = feats.len();
     let k = centres.len();
@@ -267,11 +265,9 @@ fn lloyd_counted(
     // How far each centre moved in the last update, and the most any other centre did.
     let mut drift = vec![0.0f64; k];
     let mut others = vec![0.0f64; k];
-    // A lower bound on each centre's distance to the nearest other (0 until an update).
-    let mut near = vec![0.0f64; k];
     for round in 0..iters.max(1) {
         let first = if round == 0 { first_dist } else { None };
-        let (centres_now, drift_now, others_now, near_now) = (&centres, &drift, &others, &near);
+        let (centres_now, drift_now, others_now) = (&centres, &drift, &others);
         let (changed, skips) = state
             .par_iter_mut()
             .zip(feats.par_iter())
@@ -281,10 +277,6 @@ fn lloyd_counted(
                 if bounded && b.a != usize::MAX {
                     let u = (b.u + drift_now[b.a]) * (1.0 + SLACK);
                     let l = (b.l - others_now[b.a]) * (1.0 - SLACK);
-                    // Elkan's centre–centre bound: every other centre is at least
-                    // `near[a]` from the own one, so at least `near[a] − u` from the triangle.
-                    let l_cc = (near_now[b.a] - u) * (1.0 - SLACK);
-                    let l = if l_cc > l { l_cc } else { l };
                     let l = if l > 0.0 { l } else { 0.0 };
                     if l * l * (1.0 - SLACK) - u * u * (1.0 + SLACK) - 2.0 * SLACK * lambda2 > 0.0 {
                         (b.u, b.l) = (u, l);
@@ -371,29 +363,6 @@ fn lloyd_counted(
                 *c = new;
             }
         }
-        // The centres' distances, as the drifts are computed, then lowered by the slack
-        // (their rounding is a few units in the last place of `D²`). Not a number: 0.
-        let apart = |a: &Centre, b: &Centre| {
-            let dp = (0..3).map(|j| (a.pos[j] - b.pos[j]).powi(2)).sum::<f64>();
-            let dm = (0..6)
-                .map(|j| (a.orient[j] - b.orient[j]).powi(2) * [1.0, 2.0, 2.0, 1.0, 2.0, 1.0][j])
-                .sum::<f64>();
-            let d2 = (dp + lambda2 * dm) * (1.0 - SLACK);
-            if d2 > 0.0 {
-                d2.sqrt() * (1.0 - SLACK)
-            } else {
-                0.0
-            }
-        };
-        for (j, m) in near.iter_mut().enumerate() {
-            *m = (0..k)
-                .filter(|&i| i != j)
-                .map(|i| apart(&centres[j], &centres[i]))
-                .fold(f64::INFINITY, f64::min);
-            if !elkan || !m.is_finite() {
-                *m = 0.0;
-            }
-        }
         for (j, o) in others.iter_mut().enumerate() {
             *o = (0..k)
                 .filter(|&i| i != j)
@@ -478,7 +447,7 @@ mod tests {
     #[test]
     fn bounded_lloyd_is_plain_lloyd() {
         let mut rng = crate::rng::Rng::new(37);
-        let (mut skipped, mut skipped_alone) = (0, 0);
+        let mut skipped = 0;
         let mut total = 0;
         let mut cases = 0;
         for case in 0..120 {
@@ -518,21 +487,14 @@ mod tests {
                 })
                 .collect();
             let want = plain(&feats, &areas, centres.clone(), lambda2, 12);
-            let (got, s) = lloyd_counted(&feats, &areas, centres.clone(), lambda2, 12, None, true);
+            let (got, s) = lloyd_counted(&feats, &areas, centres.clone(), lambda2, 12, None);
             assert_eq!(got, want, "case {case}: n {n}, k {k}, lambda {lambda}");
-            // Hamerly's bounds alone: the same assignment, and never more skips.
-            let (alone, h) =
-                lloyd_counted(&feats, &areas, centres.clone(), lambda2, 12, None, false);
-            assert_eq!(alone, want, "case {case} without the centre–centre bound");
-            assert!(h <= s, "case {case}: {h} skips alone, {s} with the centres' distances");
-            skipped_alone += h;
             if k == 2 {
                 let d0: Vec<f64> = feats
                     .iter()
                     .map(|x| dist2(x, &centres[0], lambda2))
                     .collect();
-                let (got, _) =
-                    lloyd_counted(&feats, &areas, centres, lambda2, 12, Some(&d0), true);
+                let (got, _) = lloyd_counted(&feats, &areas, centres, lambda2, 12, Some(&d0));
                 assert_eq!(got, want, "case {case} with the seeding's distances");
             }
             skipped += s;
@@ -540,12 +502,6 @@ mod tests {
             cases += 1;
         }
         assert_eq!(cases, 120);
-        // The centre–centre bound skips more (first measured: 352,701 triangle-rounds against
-        // 349,405 without it; 70,350 triangles, at most 12 rounds each).
-        assert!(
-            skipped > skipped_alone,
-            "{skipped} skips with the centres' distances, {skipped_alone} without"
-        );
         assert!(
             skipped > total,
             "the bounds skipped {skipped} of the triangle-rounds"
@@ -572,7 +528,7 @@ mod tests {
                 Centre::new(feats[250].pos, feats[250].orient),
             ];
             let want = plain(&feats, &areas, centres.clone(), 0.01, 12);
-            let (got, skipped) = lloyd_counted(&feats, &areas, centres, 0.01, 12, None, true);
+            let (got, skipped) = lloyd_counted(&feats, &areas, centres, 0.01, 12, None);
             assert_eq!(got, want);
             assert_eq!(skipped, 0);
         }
