@@ -284,7 +284,12 @@ mod tests {
         for pts in &clouds {
             for k in [1, 2, 5, 32] {
                 let fresh = farthest_of(pts.len(), |i| pts[i], k);
-                assert_eq!(fresh, farthest_of_plain(pts, k), "{} points, k = {k}", pts.len());
+                assert_eq!(
+                    fresh,
+                    farthest_of_plain(pts, k),
+                    "{} points, k = {k}",
+                    pts.len()
+                );
                 // The first point itself, whatever `k`.
                 if pts.len() > 1 {
                     let c = pts.iter().fold(V3::zeros(), |a, p| a + p.coords) / pts.len() as f64;
