@@ -258,7 +258,7 @@ mod tests {
             clouds.push(lattice.clone());
             // The extremes duplicated at the end (ties only in the tail or across it).
             let mut tail = lattice;
-            tail.extend_from_slice(&tail[..n.min(5)].to_vec());
+            tail.extend_from_within(..n.min(5));
             clouds.push(tail);
         }
         // Symmetric: ±1 on each axis, every extreme tied with its mirror.
