@@ -1,7 +1,7 @@
 //! Splitting a patch in two: 2-means and area-median cuts across its PCA axes (and, for
 //! `Strategy::Planes`, the scene axes); the candidates are ranked by their worse half.
 //!
-//! Entry points: [`split`], [`closest_splits`], [`split_ways`]; [`sorted_along`], [`Along`].
+//! Entry points: [`split`], [`closest_splits`], [`split_ways`]; [`sorted_along`].
 
 use super::*;
 
@@ -132,24 +132,23 @@ pub(super) fn split_ways(
                 .map(|&t| (axis.dot(&f.pos[t as usize].coords), t))
                 .collect();
             // Ordered along the axis, ties by triangle.
-            // Sorted only as far as the walk reads (the buckets up to the median, for one cut).
-            let mut sorted = Along::new(&by);
+            let sorted = sorted_along(&by);
             let key = along;
             let fracs: &[f64] = if fine { &PLANE_FRACTIONS } else { &[0.5] };
             for &frac in fracs {
                 let mut acc = 0.0;
-                let mut cut = by.len() / 2;
-                for i in 0..by.len() {
-                    acc += s.tri_area[sorted.at(i).1 as usize];
+                let mut cut = sorted.len() / 2;
+                for (i, &(_, t)) in sorted.iter().enumerate() {
+                    acc += s.tri_area[t as usize];
                     if acc >= frac * w {
-                        cut = (i + 1).clamp(1, by.len() - 1);
+                        cut = (i + 1).clamp(1, sorted.len() - 1);
                         break;
                     }
                 }
                 // The halves in the patch's (ascending) order: those before the first of the
                 // second half along the axis, and the others.
                 // (the keys distinct, `cut` of them order before it).
-                let first = sorted.at(cut);
+                let first = sorted[cut];
                 let (mut a, mut b) = (Vec::with_capacity(cut), Vec::with_capacity(by.len() - cut));
                 for x in &by {
                     if key(x, &first).is_lt() {
@@ -199,103 +198,58 @@ fn along(a: &(f64, u32), b: &(f64, u32)) -> std::cmp::Ordering {
 const BUCKET_FROM: usize = 64;
 
 /// `by` (a key along an axis and a triangle, the pairs distinct) ordered by [`along`], as a
-/// comparison sort orders them (see [`Along`]); the whole order, for the tests.
-#[cfg(test)]
+/// comparison sort orders them, but by buckets (issue #37: the two sorts of `split_ways` took
+/// 3.4 G instructions of `00005`): each key goes to one of `n / 2` buckets evenly spaced
+/// between the least and the largest key, `⌊(x − lo)·scale⌋`, which never decreases as `x`
+/// grows (each rounded step is monotone), so every key of a bucket orders before every key of
+/// a later one; each bucket, a few pairs, is then sorted by [`along`] itself. Keys not all
+/// finite, or all equal, take the comparison sort.
 pub(super) fn sorted_along(by: &[(f64, u32)]) -> Vec<(f64, u32)> {
-    let mut a = Along::new(by);
-    if !by.is_empty() {
-        a.at(by.len() - 1);
+    let n = by.len();
+    let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
+    for &(x, _) in by {
+        lo = lo.min(x);
+        hi = hi.max(x);
     }
-    a.out
-}
-
-/// `by` (a key along an axis and a triangle, the pairs distinct) in [`along`]'s order, sorted
-/// only as far as it is read ([`Along::at`]): an area-median cut reads about half of it
-/// (issue #37).
-///
-/// By buckets (the two sorts of `split_ways` took 3.4 G instructions of `00005`): each key goes
-/// to one of `n / 2` buckets evenly spaced between the least and the largest key,
-/// `⌊(x − lo)·scale⌋`, which never decreases as `x` grows (each rounded step is monotone), so
-/// every key of a bucket orders before every key of a later one; each bucket, a few pairs, is
-/// sorted by [`along`] itself when the first of its places is read. Keys not all finite, or
-/// all equal, take the comparison sort at once.
-pub(super) struct Along {
-    out: Vec<(f64, u32)>,
-    /// Where each bucket begins in `out`, and its end.
-    start: Vec<u32>,
-    /// The buckets before this one are sorted; `out[..done]` is final.
-    bucket: usize,
-    done: usize,
-}
-
-impl Along {
-    pub(super) fn new(by: &[(f64, u32)]) -> Along {
-        let n = by.len();
-        let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
-        for &(x, _) in by {
-            lo = lo.min(x);
-            hi = hi.max(x);
-        }
-        let nb = n / 2;
-        let scale = nb as f64 / (hi - lo);
-        let finite = by.iter().all(|(x, _)| x.is_finite());
-        if n < BUCKET_FROM || !finite || !(hi > lo) || !scale.is_finite() {
-            let mut out = by.to_vec();
-            out.sort_unstable_by(along);
-            return Along {
-                out,
-                start: Vec::new(),
-                bucket: 0,
-                done: n,
-            };
-        }
-        let bucket = |x: f64| (((x - lo) * scale) as usize).min(nb - 1);
-        let mut start = vec![0u32; nb + 1];
-        for &(x, _) in by {
-            start[bucket(x) + 1] += 1;
-        }
-        for b in 0..nb {
-            start[b + 1] += start[b];
-        }
-        let mut next = start.clone();
-        let mut out = vec![(0.0, 0u32); n];
-        for &p in by {
-            let b = bucket(p.0);
-            out[next[b] as usize] = p;
-            next[b] += 1;
-        }
-        Along {
-            out,
-            start,
-            bucket: 0,
-            done: 0,
-        }
+    let nb = n / 2;
+    let scale = nb as f64 / (hi - lo);
+    let finite = by.iter().all(|(x, _)| x.is_finite());
+    if n < BUCKET_FROM || !finite || !(hi > lo) || !scale.is_finite() {
+        let mut v = by.to_vec();
+        v.sort_unstable_by(along);
+        return v;
     }
-
-    /// The `i`-th in [`along`]'s order (`i` below the length), its bucket and those before it
-    /// sorted first if they were not.
-    pub(super) fn at(&mut self, i: usize) -> (f64, u32) {
-        while i >= self.done {
-            let b = self.bucket;
-            let (s, e) = (self.start[b] as usize, self.start[b + 1] as usize);
-            let part = &mut self.out[s..e];
-            if part.len() <= 16 {
-                // Insertion sort: a bucket holds two pairs on average.
-                for i in 1..part.len() {
-                    let mut j = i;
-                    while j > 0 && along(&part[j - 1], &part[j]).is_gt() {
-                        part.swap(j - 1, j);
-                        j -= 1;
-                    }
+    let bucket = |x: f64| (((x - lo) * scale) as usize).min(nb - 1);
+    let mut start = vec![0u32; nb + 1];
+    for &(x, _) in by {
+        start[bucket(x) + 1] += 1;
+    }
+    for b in 0..nb {
+        start[b + 1] += start[b];
+    }
+    let mut next = start.clone();
+    let mut out = vec![(0.0, 0u32); n];
+    for &p in by {
+        let b = bucket(p.0);
+        out[next[b] as usize] = p;
+        next[b] += 1;
+    }
+    for b in 0..nb {
+        let part = &mut out[start[b] as usize..start[b + 1] as usize];
+        if part.len() <= 16 {
+            // Insertion sort: a bucket holds two pairs on average.
+            for i in 1..part.len() {
+                let mut j = i;
+                while j > 0 && along(&part[j - 1], &part[j]).is_gt() {
+                    part.swap(j - 1, j);
+                    j -= 1;
                 }
-            } else {
-                part.sort_unstable_by(along);
             }
-            self.bucket += 1;
-            self.done = e;
+        } else {
+            part.sort_unstable_by(along);
         }
-        self.out[i]
     }
+    out
 }
 
 #[cfg(test)]
@@ -304,7 +258,7 @@ mod tests {
 
     /// The buckets order every set as the comparison sort does: uniform and clustered keys,
     /// ties (keys repeated, +0 and -0), a few far outliers, keys not finite, all keys equal,
-    /// sets below and above the bucketing size; and so do they read in part (`Along::at`).
+    /// sets below and above the bucketing size.
     #[test]
     fn sorted_along_is_the_comparison_sort() {
         let mut rng = crate::rng::Rng::new(11);
@@ -350,16 +304,6 @@ mod tests {
             let bits =
                 |v: &[(f64, u32)]| v.iter().map(|p| (p.0.to_bits(), p.1)).collect::<Vec<_>>();
             assert_eq!(bits(&got), bits(&want), "case {case}: n {n}, kind {kind}");
-            // Read in part, as a cut reads it: the median first, then back and forth.
-            let mut lazy = Along::new(&by);
-            for i in [n / 2, 0, n / 2 + 1, n - 1, n / 3] {
-                let (x, t) = lazy.at(i);
-                assert_eq!(
-                    (x.to_bits(), t),
-                    (want[i].0.to_bits(), want[i].1),
-                    "case {case}"
-                );
-            }
             checked += 1;
         }
         assert_eq!(checked, 400);
