@@ -78,7 +78,7 @@ fn farthest_from(xs: &[f64], ys: &[f64], zs: &[f64], c: &V3) -> usize {
     }
     let whole = n / LANES * LANES;
     let mut lanes = [f64::NEG_INFINITY; LANES];
-    let mut at = [0.0f64; LANES];
+    let mut at = [0usize; LANES];
     for (ch, ((x, y), z)) in xs[..whole]
         .chunks_exact(LANES)
         .zip(ys[..whole].chunks_exact(LANES))
@@ -89,7 +89,7 @@ fn farthest_from(xs: &[f64], ys: &[f64], zs: &[f64], c: &V3) -> usize {
             let e = (V3::new(x[l], y[l], z[l]) - c).norm_squared();
             let up = e > lanes[l];
             lanes[l] = if up { e } else { lanes[l] };
-            at[l] = if up { ch as f64 } else { at[l] };
+            at[l] = if up { ch } else { at[l] };
         }
     }
     let mut far = lanes
@@ -97,7 +97,7 @@ fn farthest_from(xs: &[f64], ys: &[f64], zs: &[f64], c: &V3) -> usize {
         .fold(f64::NEG_INFINITY, |m: f64, &e| if e > m { e } else { m });
     let mut first = (0..LANES)
         .filter(|&l| whole > 0 && lanes[l] == far)
-        .map(|l| at[l] as usize * LANES + l)
+        .map(|l| at[l] * LANES + l)
         .min()
         .unwrap_or(0);
     for i in whole..n {
@@ -161,11 +161,8 @@ fn picks_body(
         // Each lane's largest and the chunk of its first occurrence: the first of equals
         // overall is then the lowest index among the lanes holding the largest, with no
         // second pass over the distances to find it.
-        // The chunk as a float (exact below 2⁵³): its select then takes the same mask as the
-        // distances' (with an integer one the compiler packed and unpacked the mask, 53
-        // instructions a chunk of eight against 45).
         let mut lanes = [0.0f64; LANES];
-        let mut at = [0.0f64; LANES];
+        let mut at = [0usize; LANES];
         for (c, (((d, x), y), z)) in dist
             .chunks_exact_mut(LANES)
             .zip(xs.chunks_exact(LANES))
@@ -180,7 +177,7 @@ fn picks_body(
                 d[l] = v;
                 let up = v > lanes[l];
                 lanes[l] = if up { v } else { lanes[l] };
-                at[l] = if up { c as f64 } else { at[l] };
+                at[l] = if up { c } else { at[l] };
             }
         }
         let far = lanes
@@ -191,7 +188,7 @@ fn picks_body(
         }
         last = (0..LANES)
             .filter(|&l| lanes[l] == far)
-            .map(|l| at[l] as usize * LANES + l)
+            .map(|l| at[l] * LANES + l)
             .min()
             .expect("far is a lane's largest");
         kept.push(last);
