@@ -195,12 +195,7 @@ pub fn fit(model: &ColourProfile, guidance: &ColourProfile, o: &FitOptions) -> O
         let s = o.scale_lo * (o.scale_hi / o.scale_lo).powf(t);
         let mut best = (f64::INFINITY, 1i8, 0.0);
         for sign in [1.0f64, -1.0] {
-            // Offsets from the guidance's far end at the model's near end to the reverse.
-            let (g0, g1) = (sign * guidance.lo / s, sign * guidance.hi() / s);
-            let (gmin, gmax) = (g0.min(g1), g0.max(g1));
-            let b_lo = model.lo - gmax;
-            let b_hi = model.hi() - gmin;
-            let step = model.bin / 4.0;
+            let (b_lo, b_hi, step) = offsets(model, guidance, s, sign);
             mapped.clear();
             for (k, g) in guidance.colour.iter().enumerate() {
                 if let Some(g) = g {
@@ -219,22 +214,7 @@ pub fn fit(model: &ColourProfile, guidance: &ColourProfile, o: &FitOptions) -> O
         }
         per_scale.push((s, best.0, best.1, best.2));
     }
-    let (bs, bc, bsign, boff) = per_scale
-        .iter()
-        .copied()
-        .min_by(|a, b| a.1.total_cmp(&b.1))?;
-    let rival = per_scale
-        .iter()
-        .filter(|(s, _, _, _)| (s / bs).ln().abs() >= 1.05f64.ln())
-        .map(|p| p.1)
-        .fold(f64::INFINITY, f64::min);
-    Some(ProfileFit {
-        scale: bs,
-        cost: bc,
-        contrast: (rival + 1e-3 * o.cap) / (bc + 1e-3 * o.cap),
-        sign: bsign,
-        offset: boff,
-    })
+    best_scale(&per_scale, 1e-3 * o.cap)
 }
 
 /// Where the colour *changes*: the scale, direction and offset that best align the guidance's
@@ -288,10 +268,7 @@ pub fn fit_edges(
         }
         let mut best = (f64::INFINITY, 1i8, 0.0);
         for sign in [1.0f64, -1.0] {
-            let (g0, g1) = (sign * guidance.lo / s, sign * guidance.hi() / s);
-            let (gmin, gmax) = (g0.min(g1), g0.max(g1));
-            let (b_lo, b_hi) = (model.lo - gmax, model.hi() - gmin);
-            let step = model.bin / 4.0;
+            let (b_lo, b_hi, step) = offsets(model, guidance, s, sign);
             let mut b = b_lo;
             while b <= b_hi {
                 let (mut num, mut m2) = (0.0, 0.0);
@@ -321,6 +298,21 @@ pub fn fit_edges(
         }
         per_scale.push((s, best.0, best.1, best.2));
     }
+    best_scale(&per_scale, 1e-3)
+}
+
+/// The offsets tried at scale `s` in direction `sign`: from the guidance's far end at the
+/// model's near end to the reverse, a quarter of a model bin apart (first, last, step).
+fn offsets(model: &ColourProfile, guidance: &ColourProfile, s: f64, sign: f64) -> (f64, f64, f64) {
+    let (g0, g1) = (sign * guidance.lo / s, sign * guidance.hi() / s);
+    let (gmin, gmax) = (g0.min(g1), g0.max(g1));
+    (model.lo - gmax, model.hi() - gmin, model.bin / 4.0)
+}
+
+/// The fit of the scale whose best (direction, offset) costs least, of `per_scale`'s
+/// (scale, cost, direction, offset); its contrast is the best cost of a scale at least 5 % away
+/// against its own, both raised by `floor`.
+fn best_scale(per_scale: &[(f64, f64, i8, f64)], floor: f64) -> Option<ProfileFit> {
     let (bs, bc, bsign, boff) = per_scale
         .iter()
         .copied()
@@ -333,7 +325,7 @@ pub fn fit_edges(
     Some(ProfileFit {
         scale: bs,
         cost: bc,
-        contrast: (rival + 1e-3) / (bc + 1e-3),
+        contrast: (rival + floor) / (bc + floor),
         sign: bsign,
         offset: boff,
     })
