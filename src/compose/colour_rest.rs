@@ -24,13 +24,9 @@
 //! Entry points: [`judge`] (the gates, the guard, a [`ColourRestReport`]), [`apply`] (how
 //! `compose` calls it).
 
-use super::cloud::Cloud;
 use super::contact_scale::{visible, GapProbe};
 use super::guard::Guard;
-use super::kdtree::KdTree;
 use super::placed::{Item, Placed};
-use super::sdf::AnchorField;
-use crate::mesh::P3;
 use crate::pose::Similarity;
 use serde::Serialize;
 
@@ -57,23 +53,18 @@ pub struct ColourRestReport {
     pub taken: bool,
 }
 
-/// The gates and, when they pass, the guard (over `probe`, from `start` of stage `stage`, the
-/// normal offsets measured when `offsets`) offered `candidate` as `colour_rest` with the
-/// guidance's noise as the allowance. `gaps` measures min Φ of the item.
-#[allow(clippy::too_many_arguments)]
+/// The gates and, when they pass, the item's guard ([`Item::guard`], from `start` of stage
+/// `stage`, the normal offsets measured when `offsets`) offered `candidate` as `colour_rest`
+/// with the guidance's noise as the allowance. `gaps` measures min Φ of the item.
 pub fn judge<'a>(
-    object: &'a Cloud,
-    tree: &'a KdTree,
-    spacing: f64,
-    guidance: &Cloud,
+    item: &Item<'a>,
     gaps: &GapProbe,
-    probe: Vec<P3>,
     (start, stage): (Similarity, &str),
     candidate: Similarity,
-    field: &AnchorField,
     offsets: Option<f64>,
 ) -> (Guard<'a>, ColourRestReport) {
-    let mut guard = Guard::new(object, tree, spacing, probe, start, stage);
+    let (object, field) = (item.object, item.field);
+    let mut guard = item.guard(start, stage);
     let diag = object.diagonal();
     let g0 = gaps.gap(&start, field);
     let mut report = ColourRestReport {
@@ -101,7 +92,7 @@ pub fn judge<'a>(
     if let Some(f) = offsets {
         guard.measure_offsets(f);
     }
-    report.noise = visible(object, tree, &guidance.subsample(1500), &start).1;
+    report.noise = visible(object, item.tree, &item.guidance.subsample(1500), &start).1;
     guard.with_allowance(report.noise);
     report.taken = guard.offer("colour_rest", candidate);
     (guard, report)
@@ -112,15 +103,10 @@ pub fn judge<'a>(
 pub(super) fn apply(item: &Item, candidate: Similarity, placed: &mut Placed) -> ColourRestReport {
     let gaps = GapProbe::new(item.object.subsample(1000).points, &item.dense());
     let (g, report) = judge(
-        item.object,
-        item.tree,
-        item.spacing,
-        item.guidance,
+        item,
         &gaps,
-        item.guidance.subsample(1000).points,
         (placed.pose, placed.stage.as_str()),
         candidate,
-        item.field,
         item.offset_max(),
     );
     placed.take(&g);
@@ -130,8 +116,11 @@ pub(super) fn apply(item: &Item, candidate: Similarity, placed: &mut Placed) -> 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::compose::cloud::Cloud;
     use crate::compose::contact_scale::DENSE;
     use crate::compose::guard::spacing;
+    use crate::compose::kdtree::KdTree;
+    use crate::compose::sdf::AnchorField;
     use crate::mesh::{Mesh, V3};
 
     /// A bar 1 × 0.2 × 0.2 lying on a slab (its bottom at y = 0, the slab's top) at scale 1; the
@@ -181,20 +170,16 @@ mod tests {
         assert!(g.len() > 500, "{} guidance points", g.len());
         let dense = Cloud::sample(&vis, DENSE, 3).points;
         let gaps = GapProbe::new(obj.subsample(1000).points, &dense);
+        let item = Item {
+            visual: &vis,
+            object: &obj,
+            tree: &tree,
+            spacing: sp,
+            guidance: &g,
+            field: &field,
+        };
         let run = |start: Similarity, cand: Similarity| {
-            let probe = g.subsample(1000).points;
-            let (guard, r) = judge(
-                &obj,
-                &tree,
-                sp,
-                &g,
-                &gaps,
-                probe,
-                (start, "s"),
-                cand,
-                &field,
-                None,
-            );
+            let (guard, r) = judge(&item, &gaps, (start, "s"), cand, None);
             (guard.pose(), guard.stage().to_string(), r)
         };
         let small = pose(0.8, 0.0);

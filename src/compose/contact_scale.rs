@@ -409,26 +409,20 @@ pub struct ContactReport {
     pub taken: bool,
 }
 
-/// Run the stage on an item registered at `start` (stage `stage`) and offer its candidate to a
-/// guard over `probe` (the guidance points the registration's guard used), with the guidance's
-/// noise as the allowance; `offsets` when the registration's guard measured normal offsets;
-/// `dense`: a dense sample of the object's surface (object frame) that refines the gap
-/// ([`GapProbe`]). Returns the guard (its pose, stage and log) and the report.
-#[allow(clippy::too_many_arguments)]
+/// Run the stage on an item registered at `start` (stage `stage`) and offer its candidate to the
+/// item's guard ([`Item::guard`]), with the guidance's noise as the allowance; `offsets` when
+/// the registration's guard measured normal offsets; `dense`: a dense sample of the object's
+/// surface (object frame) that refines the gap ([`GapProbe`]). Returns the guard (its pose,
+/// stage and log) and the report.
 pub fn run<'a>(
-    object: &'a Cloud,
-    tree: &'a KdTree,
-    spacing: f64,
-    guidance: &Cloud,
+    item: &Item<'a>,
     dense: &[P3],
-    probe: Vec<P3>,
-    start: Similarity,
-    stage: &str,
-    field: &AnchorField,
+    (start, stage): (Similarity, &str),
     offsets: Option<f64>,
     o: &ContactOptions,
 ) -> (Guard<'a>, ContactReport) {
-    let mut guard = Guard::new(object, tree, spacing, probe, start, stage);
+    let (object, tree, guidance, field) = (item.object, item.tree, item.guidance, item.field);
+    let mut guard = item.guard(start, stage);
     if let Some(f) = offsets {
         guard.measure_offsets(f);
     }
@@ -479,15 +473,9 @@ pub fn run<'a>(
 /// the guard's pose, stage and log folded back into `placed`.
 pub(super) fn apply(item: &Item, o: &ContactOptions, placed: &mut Placed) -> ContactReport {
     let (g, report) = run(
-        item.object,
-        item.tree,
-        item.spacing,
-        item.guidance,
+        item,
         &item.dense(),
-        item.guidance.subsample(1000).points,
-        placed.pose,
-        &placed.stage,
-        item.field,
+        (placed.pose, &placed.stage),
         item.offset_max(),
         o,
     );
@@ -571,12 +559,16 @@ mod tests {
             *p += n * (sigma * rng.normal());
         }
         let dense = Cloud::sample(&vis, 20_000, 3).points;
-        let probe = g.subsample(1000).points;
         let o = ContactOptions::grow();
-        let sp = spacing(&vis, 4000);
-        let (guard, r) = run(
-            &obj, &tree, sp, &g, &dense, probe, truth, "s", &field, None, &o,
-        );
+        let item = Item {
+            visual: &vis,
+            object: &obj,
+            tree: &tree,
+            spacing: spacing(&vis, 4000),
+            guidance: &g,
+            field: &field,
+        };
+        let (guard, r) = run(&item, &dense, (truth, "s"), None, &o);
         assert_eq!(r.skipped, Some("in_contact"));
         assert!(!r.taken);
         assert_eq!(guard.stage(), "s");

@@ -30,7 +30,7 @@ pub struct Item<'a> {
     pub field: &'a AnchorField,
 }
 
-impl Item<'_> {
+impl<'a> Item<'a> {
     /// The normal offset a guard may take out of its fits ([`Guard::measure_offsets`]), where
     /// the item's shape lets an offset and a scale be told apart; `None` where it does not.
     pub fn offset_max(&self) -> Option<f64> {
@@ -42,6 +42,12 @@ impl Item<'_> {
     /// stage, so each stage sees the same points).
     pub fn dense(&self) -> Vec<P3> {
         Cloud::sample(self.visual, DENSE, 0x6a70).points
+    }
+
+    /// A guard over 1,000 of the guidance's points, started from `start` (stage `stage`).
+    pub fn guard(&self, start: Similarity, stage: &str) -> Guard<'a> {
+        let probe = self.guidance.subsample(1000).points;
+        Guard::new(self.object, self.tree, self.spacing, probe, start, stage)
     }
 }
 
