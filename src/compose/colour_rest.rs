@@ -120,8 +120,8 @@ mod tests {
     use crate::compose::contact_scale::DENSE;
     use crate::compose::guard::spacing;
     use crate::compose::kdtree::KdTree;
-    use crate::compose::sdf::AnchorField;
-    use crate::mesh::{Mesh, V3};
+    use crate::compose::placed::slab_field;
+    use crate::mesh::V3;
 
     /// A bar 1 × 0.2 × 0.2 lying on a slab (its bottom at y = 0, the slab's top) at scale 1; the
     /// guidance: noisy points (σ = 0.003 along the normals) on the middle of its top face only,
@@ -132,14 +132,7 @@ mod tests {
     /// guard refuse a resting candidate the guidance does not fit (moved 0.5 along the bar).
     #[test]
     fn a_floating_bar_takes_the_resting_size_and_nothing_else() {
-        let slab: Mesh = crate::shapes::cuboid(V3::new(4.0, 0.2, 4.0)).transformed(
-            &Similarity {
-                translation: V3::new(0.0, -0.1, 0.0),
-                ..Similarity::identity()
-            }
-            .matrix(),
-        );
-        let field = AnchorField::new(&[slab], 32);
+        let field = slab_field(4.0);
         let vis = crate::shapes::plain_visual(&crate::shapes::cuboid(V3::new(1.0, 0.2, 0.2)));
         let obj = Cloud::sample(&vis, 4000, 1);
         let tree = KdTree::new(&obj.points);

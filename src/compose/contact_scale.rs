@@ -487,7 +487,7 @@ pub(super) fn apply(item: &Item, o: &ContactOptions, placed: &mut Placed) -> Con
 mod tests {
     use super::*;
     use crate::compose::guard::spacing;
-    use crate::mesh::Mesh;
+    use crate::compose::placed::slab_field;
     use nalgebra::UnitQuaternion;
 
     /// A sphere (a tessellated one, tilted so no vertex sits at its bottom) 1e-3 above a slab:
@@ -495,14 +495,7 @@ mod tests {
     /// being convex), where min Φ over the 1,000 coarse samples alone reads it too large.
     #[test]
     fn gap_probe_finds_a_point_contact() {
-        let slab = crate::shapes::cuboid(V3::new(4.0, 0.2, 4.0)).transformed(
-            &Similarity {
-                translation: V3::new(0.0, -0.1, 0.0),
-                ..Similarity::identity()
-            }
-            .matrix(),
-        );
-        let field = AnchorField::new(&[slab], 32);
+        let field = slab_field(4.0);
         let ball = crate::shapes::uv_sphere(0.5, 48, 96);
         let vis = crate::shapes::plain_visual(&ball);
         let rotation = UnitQuaternion::from_euler_angles(0.3, 0.2, 0.1);
@@ -535,14 +528,7 @@ mod tests {
     /// 10 %) and a whole visible part (coverage near 1), not zeros.
     #[test]
     fn a_skip_reports_the_guidance_noise() {
-        let slab: Mesh = crate::shapes::cuboid(V3::new(2.0, 0.2, 2.0)).transformed(
-            &Similarity {
-                translation: V3::new(0.0, -0.1, 0.0),
-                ..Similarity::identity()
-            }
-            .matrix(),
-        );
-        let field = AnchorField::new(&[slab], 32);
+        let field = slab_field(2.0);
         let vis = crate::shapes::plain_visual(&crate::shapes::cuboid(V3::new(0.4, 0.3, 0.2)));
         let obj = Cloud::sample(&vis, 4000, 1);
         let tree = KdTree::new(&obj.points);
@@ -583,16 +569,7 @@ mod tests {
     /// below, must not be pulled in.
     #[test]
     fn box_on_a_slab_recovers_its_scale_from_the_contact() {
-        let slab: Mesh = crate::shapes::cuboid(V3::new(2.0, 0.2, 2.0));
-        // The slab's top face at y = 0.
-        let slab = slab.transformed(
-            &Similarity {
-                translation: V3::new(0.0, -0.1, 0.0),
-                ..Similarity::identity()
-            }
-            .matrix(),
-        );
-        let field = AnchorField::new(&[slab], 32);
+        let field = slab_field(2.0);
         let item = crate::shapes::cuboid(V3::new(0.4, 0.3, 0.2));
         let vis = crate::shapes::plain_visual(&item);
         let obj = Cloud::sample(&vis, 4000, 1);

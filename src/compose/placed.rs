@@ -70,3 +70,17 @@ impl Placed {
         self.log.extend(guard.log().iter().skip(1).cloned());
     }
 }
+
+/// For the stages' tests: the field of a slab `width` × 0.2 × `width` whose top face is the plane
+/// y = 0.
+#[cfg(test)]
+pub(super) fn slab_field(width: f64) -> AnchorField {
+    let slab = crate::shapes::cuboid(crate::mesh::V3::new(width, 0.2, width)).transformed(
+        &Similarity {
+            translation: crate::mesh::V3::new(0.0, -0.1, 0.0),
+            ..Similarity::identity()
+        }
+        .matrix(),
+    );
+    AnchorField::new(&[slab], 32)
+}

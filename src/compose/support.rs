@@ -271,7 +271,7 @@ mod tests {
     use super::*;
     use crate::compose::guard::spacing;
     use crate::compose::kdtree::KdTree;
-    use crate::mesh::Mesh;
+    use crate::compose::placed::slab_field;
     use nalgebra::UnitQuaternion;
 
     /// A box resting on a slab (top face at y = 0), its guidance only the box's top face and the
@@ -283,14 +283,7 @@ mod tests {
     /// ±1.1 %), resting on the slab; the same box at its true pose is left alone (`resting`).
     #[test]
     fn a_floating_box_is_sized_by_resting_it_on_the_slab() {
-        let slab: Mesh = crate::shapes::cuboid(V3::new(2.0, 0.2, 2.0)).transformed(
-            &Similarity {
-                translation: V3::new(0.0, -0.1, 0.0),
-                ..Similarity::identity()
-            }
-            .matrix(),
-        );
-        let field = AnchorField::new(&[slab], 32);
+        let field = slab_field(2.0);
         let vis = crate::shapes::plain_visual(&crate::shapes::cuboid(V3::new(0.4, 0.3, 0.2)));
         let obj = Cloud::sample(&vis, 5000, 1);
         let tree = KdTree::new(&obj.points);
